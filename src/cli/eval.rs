@@ -1,0 +1,30 @@
+//! `rslf eval --scene DIR --result DIR`.
+
+use crate::eval::evaluate;
+use std::path::PathBuf;
+
+/// Arguments of `rslf eval`.
+#[derive(Debug, clap::Args)]
+pub struct EvalArgs {
+    /// Scene folder with ground truth (gt_disp_lowres.pfm, gt_depth_lowres.pfm, gt_mask.png, ...).
+    #[arg(long)]
+    pub scene: PathBuf,
+    /// Result folder of `rslf train` (disparity.pfm, depth.pfm, central.png, motion.toml).
+    #[arg(long)]
+    pub result: PathBuf,
+    /// Print only; do not write RESULT/metrics.json.
+    #[arg(long)]
+    pub no_write: bool,
+}
+
+/// Evaluates, prints the table, and writes `metrics.json` into the result folder.
+pub fn run(args: EvalArgs) -> crate::Result<()> {
+    let report = evaluate(&args.scene, &args.result)?;
+    print!("{report}");
+    if !args.no_write {
+        let path = args.result.join("metrics.json");
+        report.write_json(&path)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,32 @@
+//! The `rslf` command line: argument parsing and dispatch to the subcommands.
+
+mod eval;
+mod train;
+
+use clap::{Parser, Subcommand};
+
+/// Dense depth and camera motion from one rolling-shutter light field.
+#[derive(Debug, Parser)]
+#[command(name = "rslf", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Fit a scene as a config describes and write the result folder.
+    Train(train::TrainArgs),
+    /// Compare a result folder with a scene's ground truth; print and write metrics.json.
+    Eval(eval::EvalArgs),
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> crate::Result<()> {
+    match cli.command {
+        Command::Train(args) => train::run(args),
+        Command::Eval(args) => eval::run(args),
+    }
+}

@@ -1,0 +1,65 @@
+//! `rslf train CONFIG [--scene DIR] [--out DIR]`.
+
+use crate::config::Config;
+use crate::eval::evaluate;
+use crate::io::{GroundTruth, Scene};
+use crate::pipeline;
+use std::path::PathBuf;
+
+/// Arguments of `rslf train`.
+#[derive(Debug, clap::Args)]
+pub struct TrainArgs {
+    /// The run's TOML config (see configs/).
+    pub config: PathBuf,
+    /// Scene folder; overrides the config's `scene`.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Result folder; overrides the config's `out`.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Loads config and scene, runs the pipeline, writes the result folder (and `metrics.json`
+/// when the scene has ground truth).
+pub fn run(args: TrainArgs) -> crate::Result<()> {
+    let config = Config::read(&args.config)?;
+    let scene_dir = args.scene.or(config.scene.clone()).ok_or_else(|| {
+        crate::Error::Usage(format!("{}: no scene: set `scene` in the config or pass --scene DIR", args.config.display()))
+    })?;
+    let out = args.out.or(config.out.clone()).unwrap_or_else(|| {
+        let stem = args.config.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned());
+        PathBuf::from("results").join(stem)
+    });
+    let scene = Scene::load(&scene_dir)?;
+    let gt = GroundTruth::load(&scene_dir, scene.width(), scene.height())?;
+    println!(
+        "scene {}: {} of {} views, {}x{} px, {} channel(s), {}",
+        scene_dir.display(),
+        scene.present_views().len(),
+        scene.grid.len(),
+        scene.width(),
+        scene.height(),
+        scene.channels(),
+        match (&scene.params, scene.is_rolling_shutter()) {
+            (None, _) => "no parameters.cfg: disparity only, no depth or motion".to_string(),
+            (Some(_), true) => "rolling shutter".to_string(),
+            (Some(_), false) => "global shutter".to_string(),
+        }
+    );
+    let (result, log) = pipeline::run(&config, &scene);
+    for line in &log.lines {
+        println!("{line}");
+    }
+    let written = result.write(&out, scene.camera().as_ref())?;
+    for path in &written {
+        println!("wrote {}", path.display());
+    }
+    if !gt.is_empty() {
+        let report = evaluate(&scene_dir, &out)?;
+        print!("{report}");
+        let path = out.join("metrics.json");
+        report.write_json(&path)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}

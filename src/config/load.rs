@@ -1,0 +1,175 @@
+//! Reading a config file, with errors that name the file, the line, the key and what was expected.
+
+use super::schema::Config;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A problem with a config file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConfigError {
+    /// The config file.
+    pub path: PathBuf,
+    /// 1-based line of the problem, when known.
+    pub line: Option<usize>,
+    /// Dotted key at fault (`stage1.iterations`), when known.
+    pub key: Option<String>,
+    /// What is wrong and what was expected.
+    pub message: String,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.path.display())?;
+        if let Some(line) = self.line {
+            write!(f, ":{line}")?;
+        }
+        if let Some(key) = &self.key {
+            write!(f, ": key `{key}`")?;
+        }
+        write!(f, ": {}", self.message)
+    }
+}
+
+impl std::error::Error for ConfigError {}
+
+/// The table header (`[stage1]`, `[[loss]]`) in force at byte `offset` of `text`.
+fn table_at(text: &str, offset: usize) -> Option<String> {
+    text[..offset.min(text.len())].lines().rev().find_map(|l| {
+        let l = l.trim();
+        let name = l.strip_prefix("[[").and_then(|r| r.split("]]").next()).or_else(|| {
+            l.strip_prefix('[').and_then(|r| r.split(']').next())
+        })?;
+        Some(name.trim().to_string())
+    })
+}
+
+/// The key assigned on the line holding byte `offset`, if that line is `key = value`.
+fn key_at(text: &str, offset: usize) -> Option<String> {
+    let start = text[..offset.min(text.len())].rfind('\n').map_or(0, |i| i + 1);
+    let line = text[start..].lines().next()?;
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim().trim_matches('"');
+    (!key.is_empty() && !key.starts_with('[')).then(|| key.to_string())
+}
+
+impl Config {
+    /// Parses config text; `path` is only used to name the file in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let config: Config = toml::from_str(text).map_err(|e| {
+            let span = e.span();
+            let line = span.as_ref().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            let key = span.as_ref().and_then(|s| {
+                let key = key_at(text, s.start)?;
+                Some(match table_at(text, s.start) {
+                    Some(table) => format!("{table}.{key}"),
+                    None => key,
+                })
+            });
+            // The message of an unknown key already names it; keep ours for type errors.
+            let message = e.message().trim().replace('\n', " ");
+            let key = if message.starts_with("unknown field") { None } else { key };
+            ConfigError { path: path.to_path_buf(), line, key, message }
+        })?;
+        config.validate().map_err(|(key, message)| ConfigError {
+            path: path.to_path_buf(),
+            line: None,
+            key: Some(key),
+            message,
+        })?;
+        Ok(config)
+    }
+
+    /// Reads and checks a config file.
+    pub fn read(path: &Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ConfigError {
+            path: path.to_path_buf(),
+            line: None,
+            key: None,
+            message: crate::io::IoError::os(path, e).problem,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Range checks serde cannot express: `(key, problem)` of the first one that fails.
+    fn validate(&self) -> Result<(), (String, String)> {
+        let fail = |key: &str, msg: &str| Err((key.to_string(), msg.to_string()));
+        if self.stage1.gaussians == 0 {
+            return fail("stage1.gaussians", "must be at least 1");
+        }
+        if self.stage1.views == 0 {
+            return fail("stage1.views", "must be at least 1 (the central view)");
+        }
+        if !(self.stage1.disparity_step > 0.0 && self.stage1.disparity_step.is_finite()) {
+            return fail("stage1.disparity_step", "must be a positive number of pixels");
+        }
+        if let Some([lo, hi]) = self.stage1.disparity_range {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return fail("stage1.disparity_range", "must be [min, max] with min < max");
+            }
+            if (hi - lo) / self.stage1.disparity_step > 100_000.0 {
+                return fail("stage1.disparity_range", "has more than 100000 candidates at this disparity_step");
+            }
+        }
+        if self.stage2.band_height == 0 {
+            return fail("stage2.band_height", "must be at least 1 row");
+        }
+        if self.motion.model.is_empty() {
+            return fail("motion.model", "must name a motion model");
+        }
+        if self.motion.segments == 0 {
+            return fail("motion.segments", "must be at least 1");
+        }
+        for (i, term) in self.loss.iter().enumerate() {
+            if term.kind.is_empty() {
+                return Err((format!("loss[{i}].kind"), "must name a loss term".into()));
+            }
+            if !term.weight.is_finite() || term.weight < 0.0 {
+                return Err((format!("loss[{i}].weight"), "must be a finite number >= 0".into()));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Config, ConfigError> {
+        Config::parse(text, Path::new("run.toml"))
+    }
+
+    #[test]
+    fn defaults_fill_what_a_config_leaves_out() {
+        let c = parse("scene = \"scenes/a\"\n").unwrap();
+        assert_eq!(c.scene.as_deref(), Some(Path::new("scenes/a")));
+        assert_eq!(c.stage1.gaussians, 20_000);
+        assert_eq!(c.motion.model, "constant_velocity");
+        assert_eq!(c.loss.len(), 1);
+    }
+
+    #[test]
+    fn unknown_keys_are_named_with_file_and_line() {
+        let err = parse("scene = \"a\"\n\n[stage1]\niterations = 10\nlearning_rat = 0.1\n").unwrap_err();
+        let text = err.to_string();
+        assert!(text.starts_with("run.toml:5: "), "{text}");
+        assert!(text.contains("unknown field `learning_rat`"), "{text}");
+        assert!(text.contains("expected one of"), "{text}");
+    }
+
+    #[test]
+    fn wrong_types_name_the_dotted_key_and_the_expected_type() {
+        let err = parse("[stage2]\niterations = \"many\"\n").unwrap_err();
+        assert_eq!(err.line, Some(2));
+        assert_eq!(err.key.as_deref(), Some("stage2.iterations"));
+        assert!(err.message.contains("expected"), "{}", err.message);
+        let err = parse("device = \"tpu\"\n").unwrap_err();
+        assert!(err.to_string().contains("device"), "{err}");
+    }
+
+    #[test]
+    fn ranges_are_checked() {
+        let err = parse("[[loss]]\nkind = \"l1\"\nweight = -1.0\n").unwrap_err();
+        assert_eq!(err.key.as_deref(), Some("loss[0].weight"));
+    }
+}

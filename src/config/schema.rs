@@ -1,0 +1,159 @@
+//! The TOML run configuration: which scene, where results go, which device, and how each stage,
+//! the motion model and the loss terms are set. Every table refuses keys it does not know.
+
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Which burn device runs the tensor programs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DeviceChoice {
+    /// burn's pure-Rust CPU backend.
+    #[default]
+    Flex,
+    /// The GPU through wgpu (Vulkan, Metal, DX12 or OpenGL).
+    Wgpu,
+}
+
+impl std::str::FromStr for DeviceChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "flex" => Ok(Self::Flex),
+            "wgpu" => Ok(Self::Wgpu),
+            other => Err(format!("unknown device `{other}` (expected flex or wgpu)")),
+        }
+    }
+}
+
+/// A whole run: `rslf train CONFIG`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// The scene folder (FORMAT layout). `--scene` overrides it.
+    #[serde(default)]
+    pub scene: Option<PathBuf>,
+    /// The result folder. `--out` overrides it; default `results/<config name>`.
+    #[serde(default)]
+    pub out: Option<PathBuf>,
+    /// `flex` (CPU, default) or `wgpu` (GPU).
+    #[serde(default)]
+    pub device: DeviceChoice,
+    /// Seed of every random choice of the run (Gaussian sampling, ...).
+    #[serde(default)]
+    pub seed: u64,
+    /// Stage 1: RS-agnostic geometry from the central row of views.
+    #[serde(default)]
+    pub stage1: Stage1Config,
+    /// Stage 2: motion from the off-row views.
+    #[serde(default)]
+    pub stage2: Stage2Config,
+    /// The motion model of stage 2.
+    #[serde(default)]
+    pub motion: MotionConfig,
+    /// Loss terms and their weights (`[[loss]]` tables); default: photometric L1.
+    #[serde(default = "default_losses")]
+    pub loss: Vec<LossConfig>,
+}
+
+/// Stage 1 settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Stage1Config {
+    /// Number of Gaussians sampled on the central view.
+    pub gaussians: usize,
+    /// Adam iterations of the stage-1 fit (0 = initialisation only).
+    pub iterations: usize,
+    /// How many views of the central row to fit, centred on the central view.
+    pub views: usize,
+    /// Disparity search range `[min, max]` of the initial plane sweep, pixels; default: the
+    /// scene's `[meta] disp_min, disp_max`, else `[-4, 4]`.
+    pub disparity_range: Option<[f64; 2]>,
+    /// Step between plane-sweep candidates, pixels.
+    pub disparity_step: f64,
+}
+
+impl Default for Stage1Config {
+    fn default() -> Self {
+        Self { gaussians: 20_000, iterations: 100, views: 5, disparity_range: None, disparity_step: 0.05 }
+    }
+}
+
+/// Which off-row views stage 2 compares against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ViewSelection {
+    /// The four corner views (the paper's choice).
+    #[default]
+    Corners,
+    /// Every present view off the central row.
+    AllOffRow,
+}
+
+/// Stage 2 settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Stage2Config {
+    /// Adam iterations of the motion fit (0 = no motion estimation).
+    pub iterations: usize,
+    /// The views compared against.
+    pub views: ViewSelection,
+    /// Rows per band rendered at one read-out time.
+    pub band_height: usize,
+}
+
+impl Default for Stage2Config {
+    fn default() -> Self {
+        Self { iterations: 100, views: ViewSelection::Corners, band_height: 16 }
+    }
+}
+
+/// The motion model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MotionConfig {
+    /// Registry name: `constant_velocity`, `constant_acceleration`, `piecewise_constant`, ...
+    pub model: String,
+    /// Segments of `piecewise_constant`.
+    pub segments: usize,
+}
+
+impl Default for MotionConfig {
+    fn default() -> Self {
+        Self { model: "constant_velocity".into(), segments: 4 }
+    }
+}
+
+/// One loss term: a registry name and its weight.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LossConfig {
+    /// Registry name: `l1`, `l2`, `dssim`, `smoothness`, `motion_prior`, ...
+    pub kind: String,
+    /// Weight of the term in the total loss.
+    #[serde(default = "one")]
+    pub weight: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+fn default_losses() -> Vec<LossConfig> {
+    vec![LossConfig { kind: "l1".into(), weight: 1.0 }]
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self {
+            scene: None,
+            out: None,
+            device: DeviceChoice::default(),
+            seed: 0,
+            stage1: Stage1Config::default(),
+            stage2: Stage2Config::default(),
+            motion: MotionConfig::default(),
+            loss: default_losses(),
+        }
+    }
+}

@@ -1,0 +1,106 @@
+//! The evaluation report: what `rslf eval` prints and writes as `metrics.json`.
+
+use super::metrics::{DepthMetrics, DisparityMetrics, ParameterError};
+use crate::io::{IoError, IoResult, write_atomic};
+use serde::Serialize;
+use std::fmt;
+use std::path::Path;
+
+/// Depth metrics and where the two depth maps came from.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DepthReport {
+    /// The metrics.
+    #[serde(flatten)]
+    pub metrics: DepthMetrics,
+    /// File of the estimate (`depth.pfm`, or `disparity.pfm` converted with the camera).
+    pub estimate_source: String,
+    /// File of the truth (`gt_depth_lowres.pfm`, or `gt_disp_lowres.pfm` converted).
+    pub truth_source: String,
+}
+
+/// Motion errors.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MotionReport {
+    /// The estimated model.
+    pub estimated_model: String,
+    /// The true model.
+    pub true_model: String,
+    /// Errors per parameter group, when both use the same model.
+    pub parameters: Option<Vec<ParameterError>>,
+}
+
+/// Everything `rslf eval` measured. Non-finite numbers are written as `null`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct EvalReport {
+    /// The scene folder.
+    pub scene: String,
+    /// The result folder.
+    pub result: String,
+    /// Disparity metrics (HCI, 15-pixel border left out), when both maps exist.
+    pub disparity: Option<DisparityMetrics>,
+    /// Depth metrics (the paper's), when both depths exist or can be derived.
+    pub depth: Option<DepthReport>,
+    /// PSNR (dB) of `central.png` against `gt_central.png`.
+    pub central_psnr_db: Option<f64>,
+    /// Motion errors, when both motion files exist.
+    pub motion: Option<MotionReport>,
+    /// What could not be evaluated, and why.
+    pub notes: Vec<String>,
+}
+
+fn num(v: f64, digits: usize) -> String {
+    if v.is_finite() { format!("{v:.digits$}") } else { format!("{v}") }
+}
+
+impl fmt::Display for EvalReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "scene   {}", self.scene)?;
+        writeln!(f, "result  {}", self.result)?;
+        if let Some(d) = &self.disparity {
+            let bad: Vec<String> = d.badpix_percent.iter().map(|(t, p)| format!("BadPix({t}) {}%", num(*p, 2))).collect();
+            writeln!(f, "disparity  MSE x100 {}  {}  [{} px]", num(d.mse_x100, 4), bad.join("  "), d.pixels)?;
+            if d.non_finite > 0 {
+                writeln!(f, "           {} estimates are not finite (counted as bad)", d.non_finite)?;
+            }
+        }
+        if let Some(d) = &self.depth {
+            let m = &d.metrics;
+            writeln!(
+                f,
+                "depth      abs diff {} m  RMSE {} m  delta<1.25 {}  [{} px; {} vs {}]",
+                num(m.abs_diff_m, 4),
+                num(m.rmse_m, 4),
+                num(m.delta_1_25, 4),
+                m.pixels,
+                d.estimate_source,
+                d.truth_source
+            )?;
+        }
+        if let Some(p) = self.central_psnr_db {
+            writeln!(f, "central    PSNR {} dB", num(p, 2))?;
+        }
+        if let Some(m) = &self.motion {
+            match &m.parameters {
+                Some(groups) => {
+                    for g in groups {
+                        let rel = g.relative.map_or("n/a (true value is zero)".to_string(), |r| format!("{}%", num(100.0 * r, 2)));
+                        writeln!(f, "motion     {:<13} |error| {:.4e}  relative {rel}", g.name, g.absolute)?;
+                    }
+                }
+                None => writeln!(f, "motion     estimated `{}` vs true `{}`: parameters not comparable", m.estimated_model, m.true_model)?,
+            }
+        }
+        for note in &self.notes {
+            writeln!(f, "note: {note}")?;
+        }
+        Ok(())
+    }
+}
+
+impl EvalReport {
+    /// Writes the report as pretty JSON (non-finite numbers as `null`), whole or not at all.
+    pub fn write_json(&self, path: &Path) -> IoResult<()> {
+        let json = serde_json::to_string_pretty(self).map_err(|e| IoError::new(path, e.to_string()))?;
+        write_atomic(path, json.as_bytes())
+    }
+}

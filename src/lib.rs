@@ -1,0 +1,21 @@
+//! # rslf
+//!
+//! A differentiable render-and-compare framework whose flagship model recovers dense depth and
+//! camera motion from a single light field captured with a rolling-shutter sensor (McGriff et
+//! al., "Dense Scene Reconstruction from Light-Field Images Affected by Rolling Shutter",
+//! WACV 2025).
+//!
+//! Layers, bottom to top: [`io`] (files), [`geometry`] (the camera model), [`config`] (run
+//! settings), [`pipeline`] (the RSLF composition), [`eval`] (metrics), [`cli`] (the `rslf`
+//! command).
+
+pub mod cli;
+pub mod config;
+pub mod error;
+pub mod eval;
+pub mod geometry;
+pub mod io;
+pub mod pipeline;
+pub mod progress;
+
+pub use error::{Error, Result};

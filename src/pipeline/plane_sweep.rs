@@ -1,0 +1,167 @@
+//! Stage-1 initial disparity: a plane sweep over the views of the central row.
+//!
+//! The views of the central row read every image row at the same instant, so the disparity
+//! between them holds no motion. For each candidate disparity `d`, each view (offset `dx`) is
+//! sampled at `u - dx d` on the same row and compared with the central view. Occlusions are
+//! handled by keeping the better of the two half-rows (views left of centre, views right of
+//! centre): a point hidden on one side is usually visible on the other. Costs are averaged over
+//! a square window, the best candidate is refined to sub-pixel precision by a parabola, and the
+//! depth of the cost minimum is kept as a confidence.
+
+use crate::geometry::ViewId;
+use crate::io::{Raster, Scene};
+use rayon::prelude::*;
+
+/// Settings of the sweep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneSweepSettings {
+    /// Smallest and largest disparity tried, pixels.
+    pub range: (f64, f64),
+    /// Step between candidates, pixels.
+    pub step: f64,
+    /// Half-size of the square cost window (window = 2 r + 1).
+    pub window_radius: usize,
+}
+
+/// A disparity map and its per-pixel confidence.
+#[derive(Debug, Clone)]
+pub struct DisparityEstimate {
+    /// Disparity of the central view, pixels (FORMAT sign).
+    pub disparity: Raster,
+    /// How much lower the chosen cost is than its neighbours' (intensity units; higher = surer).
+    pub confidence: Raster,
+}
+
+/// Mean absolute difference per pixel against the central view, over `views`, for disparity `d`;
+/// `INFINITY` where no view sees the pixel.
+fn half_cost(central: &Raster, views: &[(f32, &Raster)], d: f32, out: &mut [f32]) {
+    let (w, ch) = (central.width, central.channels);
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, cost) in row.iter_mut().enumerate() {
+            let (mut sum, mut n) = (0.0f32, 0u32);
+            for &(dx, view) in views {
+                let xs = x as f32 - dx * d;
+                if xs < 0.0 || xs > (w - 1) as f32 {
+                    continue;
+                }
+                let x0 = (xs as usize).min(w.saturating_sub(2));
+                let f = xs - x0 as f32;
+                let (a, b) = ((y * w + x0) * ch, (y * w + (x0 + 1).min(w - 1)) * ch);
+                for c in 0..ch {
+                    let s = view.data[a + c] * (1.0 - f) + view.data[b + c] * f;
+                    sum += (s - central.data[(y * w + x) * ch + c]).abs();
+                }
+                n += ch as u32;
+            }
+            *cost = if n == 0 { f32::INFINITY } else { sum / n as f32 };
+        }
+    });
+}
+
+/// Mean over a `(2r+1)^2` window, ignoring non-finite entries (`INFINITY` if none is finite).
+fn box_mean(src: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
+    let horizontal = |data: &[f32], out: &mut [(f32, u32)]| {
+        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate() {
+                let (lo, hi) = (x.saturating_sub(r), (x + r).min(w - 1));
+                let (mut s, mut n) = (0.0, 0);
+                for v in &data[y * w + lo..=y * w + hi] {
+                    if v.is_finite() {
+                        s += v;
+                        n += 1;
+                    }
+                }
+                *o = (s, n);
+            }
+        });
+    };
+    let mut rows = vec![(0.0f32, 0u32); w * h];
+    horizontal(src, &mut rows);
+    let mut out = vec![0.0f32; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        let (lo, hi) = (y.saturating_sub(r), (y + r).min(h - 1));
+        for (x, o) in row.iter_mut().enumerate() {
+            let (mut s, mut n) = (0.0, 0);
+            for yy in lo..=hi {
+                let (a, b) = rows[yy * w + x];
+                s += a;
+                n += b;
+            }
+            *o = if n == 0 { f32::INFINITY } else { s / n as f32 };
+        }
+    });
+    out
+}
+
+/// Runs the sweep on `views` (views of the central row; others are ignored), calling
+/// `progress(done, total)` after each candidate.
+pub fn plane_sweep(
+    scene: &Scene,
+    views: &[ViewId],
+    settings: &PlaneSweepSettings,
+    mut progress: impl FnMut(usize, usize),
+) -> DisparityEstimate {
+    let central = scene.central();
+    let (w, h) = (central.width, central.height);
+    let centre = scene.central_id();
+    let mut left = Vec::new();
+    let mut right = Vec::new();
+    for &v in views.iter().filter(|v| v.row == centre.row && v.col != centre.col) {
+        if let Some(img) = scene.view(v) {
+            let dx = scene.grid.offset(v).0 as f32;
+            if dx < 0.0 { left.push((dx, img)) } else { right.push((dx, img)) }
+        }
+    }
+    let (lo, hi) = settings.range;
+    let labels = (((hi - lo) / settings.step).round() as usize + 1).max(1);
+    let n = w * h;
+    let mut best = vec![(f32::INFINITY, 0usize); n];
+    let mut before = vec![f32::INFINITY; n];
+    let mut after = vec![f32::INFINITY; n];
+    let mut previous = vec![f32::INFINITY; n];
+    let (mut cl, mut cr) = (vec![0.0f32; n], vec![0.0f32; n]);
+    for l in 0..labels {
+        let d = (lo + l as f64 * settings.step) as f32;
+        half_cost(central, &left, d, &mut cl);
+        half_cost(central, &right, d, &mut cr);
+        let (bl, br) = (box_mean(&cl, w, h, settings.window_radius), box_mean(&cr, w, h, settings.window_radius));
+        let cost: Vec<f32> = bl.iter().zip(&br).map(|(a, b)| a.min(*b)).collect();
+        best.par_iter_mut()
+            .zip(before.par_iter_mut())
+            .zip(after.par_iter_mut())
+            .zip(previous.par_iter_mut())
+            .zip(cost.par_iter())
+            .for_each(|((((b, bf), af), prev), &c)| {
+                if b.1 + 1 == l && l > 0 {
+                    *af = c;
+                }
+                if c < b.0 {
+                    *b = (c, l);
+                    *bf = *prev;
+                    *af = f32::INFINITY;
+                }
+                *prev = c;
+            });
+        progress(l + 1, labels);
+    }
+    let mut disparity = Raster::zeros(w, h, 1);
+    let mut confidence = Raster::zeros(w, h, 1);
+    for i in 0..n {
+        let ((c0, l), cm, cp) = (best[i], before[i], after[i]);
+        let mut offset = 0.0f64;
+        if cm.is_finite() && cp.is_finite() {
+            let curvature = cm + cp - 2.0 * c0;
+            if curvature > 1e-12 {
+                offset = (0.5 * (cm - cp) / curvature).clamp(-0.5, 0.5) as f64;
+            }
+        }
+        disparity.data[i] = (lo + (l as f64 + offset) * settings.step) as f32;
+        let neighbours = [cm, cp].into_iter().filter(|c| c.is_finite()).collect::<Vec<_>>();
+        confidence.data[i] = if c0.is_finite() && !neighbours.is_empty() {
+            (neighbours.iter().sum::<f32>() / neighbours.len() as f32 - c0).max(0.0)
+        } else {
+            0.0
+        };
+    }
+    DisparityEstimate { disparity, confidence }
+}

@@ -1,0 +1,75 @@
+//! Helpers shared by the end-to-end tests: where the HCI scenes are, and tiny scenes made here.
+#![allow(dead_code)]
+
+use rslf::io::{Raster, SceneParameters, view_file_name, write_png};
+use std::path::{Path, PathBuf};
+
+/// A folder of the HCI benchmark scenes (`../shared/data/hci` beside the project, or
+/// `$RSLF_HCI_DIR`). Panics with a clear message when it is not there: these tests are the
+/// project's proof of its conventions on real data and must not be skipped silently.
+pub fn hci(scene: &str) -> PathBuf {
+    let root = std::env::var_os("RSLF_HCI_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/hci"));
+    let dir = root.join(scene);
+    assert!(dir.is_dir(), "HCI scene not found at {} (set RSLF_HCI_DIR to the folder holding antinous/, cotton/, dino/)", dir.display());
+    dir
+}
+
+/// A deterministic texture in [0, 1]: a sum of sinusoids at several scales plus hashed noise.
+pub fn texture(x: f64, y: f64, channel: usize) -> f32 {
+    let c = channel as f64;
+    let v = 0.5
+        + 0.18 * (0.37 * x + 0.11 * y + c).sin()
+        + 0.12 * (0.05 * x - 0.29 * y + 2.0 * c).sin()
+        + 0.10 * (0.71 * x + 0.53 * y).sin() * (0.13 * y - 0.07 * x + c).cos();
+    v.clamp(0.0, 1.0) as f32
+}
+
+/// Parameters of a small `n x n` grid scene of `w x h` pixels.
+pub fn params(w: usize, h: usize, n: usize) -> SceneParameters {
+    SceneParameters {
+        focal_length_mm: 50.0,
+        image_resolution_x_px: w,
+        image_resolution_y_px: h,
+        sensor_size_mm: 36.0,
+        num_cams_x: n,
+        num_cams_y: n,
+        baseline_mm: 10.0,
+        focus_distance_m: 2.0,
+        disparity_range: Some((-2.0, 2.0)),
+        line_time_s: None,
+    }
+}
+
+/// Writes a fronto-parallel textured plane of constant disparity `d` as an `n x n` light field:
+/// view (r, c) at pixel (x, y) shows the central texture at `(x + (c-cc) d, y + (r-rc) d)`.
+/// Only the views whose index passes `keep` are written.
+pub fn write_plane_scene(dir: &Path, w: usize, h: usize, n: usize, d: f64, keep: impl Fn(usize) -> bool) {
+    std::fs::create_dir_all(dir).unwrap();
+    let cc = (n as f64 - 1.0) / 2.0;
+    for r in 0..n {
+        for c in 0..n {
+            let index = r * n + c;
+            if !keep(index) {
+                continue;
+            }
+            let mut img = Raster::zeros(w, h, 3);
+            for y in 0..h {
+                for x in 0..w {
+                    let (sx, sy) = (x as f64 + (c as f64 - cc) * d, y as f64 + (r as f64 - cc) * d);
+                    for ch in 0..3 {
+                        img.set(x, y, ch, texture(sx, sy, ch));
+                    }
+                }
+            }
+            write_png(&dir.join(view_file_name(index)), &img).unwrap();
+        }
+    }
+}
+
+/// Runs the `rslf` binary; returns (exit success, stdout, stderr).
+pub fn rslf(args: &[&str]) -> (bool, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rslf")).args(args).output().unwrap();
+    (out.status.success(), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}

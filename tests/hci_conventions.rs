@@ -1,0 +1,111 @@
+//! FORMAT conventions checked against the real HCI benchmark scenes in `../shared/data/hci`.
+
+mod common;
+
+use common::{hci, rslf};
+use rslf::geometry::{ViewGrid, ViewId};
+use rslf::io::{Raster, Scene, read_pfm};
+
+#[test]
+fn antinous_loads_81_views_of_512x512_without_a_camera() {
+    let scene = Scene::load(&hci("antinous")).unwrap();
+    assert_eq!(scene.grid, ViewGrid { rows: 9, cols: 9 });
+    assert_eq!(scene.present_views().len(), 81);
+    assert_eq!((scene.width(), scene.height(), scene.channels()), (512, 512, 3));
+    assert!(scene.params.is_none() && scene.camera().is_none());
+    assert_eq!(scene.central_id(), ViewId { row: 4, col: 4 });
+}
+
+#[test]
+fn cotton_loads_33_views_with_its_central_row_corners_and_camera() {
+    let scene = Scene::load(&hci("cotton")).unwrap();
+    assert_eq!(scene.present_views().len(), 33);
+    assert_eq!(scene.central_row_views().len(), 9);
+    for corner in scene.grid.corners() {
+        assert!(scene.view(corner).is_some(), "corner {corner:?} missing");
+    }
+    assert!(scene.view(ViewId { row: 0, col: 1 }).is_none(), "cotton ships 33 of 81 views");
+    let cam = scene.camera().unwrap();
+    assert!((cam.f_px - 100.0 * 512.0 / 35.0).abs() < 1e-9);
+    assert!((cam.baseline_m - 0.025).abs() < 1e-12 && (cam.focus_m - 4.25).abs() < 1e-12);
+    assert!(!scene.is_rolling_shutter());
+    assert_eq!(scene.params.as_ref().unwrap().disparity_range, Some((-1.6, 1.5)));
+}
+
+/// Mean absolute difference between the central view and `view` warped to it with `sign * gt`
+/// disparity, over pixels that stay inside the view.
+fn warp_error(scene: &Scene, gt: &Raster, view: ViewId, sign: f64) -> f64 {
+    let central = scene.central();
+    let img = scene.view(view).unwrap();
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for y in 20..central.height - 20 {
+        for x in 20..central.width - 20 {
+            let d = sign * gt.get(x, y, 0) as f64;
+            let (xs, ys) = scene.grid.position_in_view(view, x as f64, y as f64, d);
+            for ch in 0..3 {
+                if let Some(s) = img.sample_bilinear(xs as f32, ys as f32, ch) {
+                    sum += (s - central.get(x, y, ch)).abs() as f64;
+                    n += 1;
+                }
+            }
+        }
+    }
+    sum / n as f64
+}
+
+#[test]
+fn the_disparity_sign_of_format_reproduces_antinous_central_view() {
+    let dir = hci("antinous");
+    let scene = Scene::load(&dir).unwrap();
+    let gt = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
+    // Corners and the ends of the central row and column: every direction of the rule.
+    let views = [(0, 0), (0, 8), (8, 0), (8, 8), (4, 0), (4, 8), (0, 4), (8, 4)];
+    for (row, col) in views {
+        let view = ViewId { row, col };
+        let right = warp_error(&scene, &gt, view, 1.0);
+        let wrong = warp_error(&scene, &gt, view, -1.0);
+        assert!(right < 0.02, "view {view:?}: error {right} with FORMAT's sign");
+        assert!(wrong > 3.0 * right, "view {view:?}: FORMAT's sign {right} vs opposite {wrong}");
+    }
+}
+
+#[test]
+fn hci_ground_truth_pfm_reads_as_a_512x512_map_in_the_scene_range() {
+    let gt = read_pfm(&hci("antinous").join("gt_disp_lowres.pfm")).unwrap();
+    assert_eq!((gt.width, gt.height, gt.channels), (512, 512, 1));
+    assert!(gt.data.iter().all(|v| v.is_finite() && (-3.5..3.0).contains(v)));
+    // Bottom-first storage: the rows read back top-first must match the file read by hand.
+    let bytes = std::fs::read(hci("antinous").join("gt_disp_lowres.pfm")).unwrap();
+    let data = &bytes[bytes.len() - 512 * 512 * 4..];
+    let first_stored = f32::from_le_bytes(data[..4].try_into().unwrap());
+    assert_eq!(gt.get(0, 511, 0).to_bits(), first_stored.to_bits());
+}
+
+#[test]
+fn pfm_round_trips_hci_ground_truth_bit_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let gt = read_pfm(&hci("antinous").join("gt_disp_lowres.pfm")).unwrap();
+    let path = dir.path().join("copy.pfm");
+    rslf::io::write_pfm(&path, &gt).unwrap();
+    let back = read_pfm(&path).unwrap();
+    assert_eq!(back.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>(), gt.data.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    assert_eq!(std::fs::read(&path).unwrap(), std::fs::read(hci("antinous").join("gt_disp_lowres.pfm")).unwrap());
+}
+
+#[test]
+fn eval_of_antinous_ground_truth_against_itself_is_perfect() {
+    let scene = hci("antinous");
+    let result = tempfile::tempdir().unwrap();
+    std::fs::copy(scene.join("gt_disp_lowres.pfm"), result.path().join("disparity.pfm")).unwrap();
+    let (ok, stdout, stderr) = rslf(&["eval", "--scene", scene.to_str().unwrap(), "--result", result.path().to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("MSE x100 0.0000"), "{stdout}");
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(result.path().join("metrics.json")).unwrap()).unwrap();
+    let disp = &json["disparity"];
+    assert_eq!(disp["mse_x100"], 0.0);
+    assert_eq!(disp["pixels"], (512 - 30) * (512 - 30));
+    for entry in disp["badpix_percent"].as_array().unwrap() {
+        assert_eq!(entry[1], 0.0, "{entry}");
+    }
+    assert!(json["depth"].is_null(), "antinous has no parameters.cfg: no depth");
+}

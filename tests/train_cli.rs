@@ -1,0 +1,67 @@
+//! `rslf train` end to end on a small scene of known geometry.
+
+mod common;
+
+use common::{params, rslf, write_plane_scene};
+use rslf::geometry::Camera;
+use rslf::io::{Raster, read_image, read_pfm, write_pfm};
+
+#[test]
+fn train_recovers_the_disparity_of_a_plane_and_writes_a_format_result() {
+    let root = tempfile::tempdir().unwrap();
+    let scene = root.path().join("plane");
+    let (w, h, d) = (64, 48, 0.75);
+    write_plane_scene(&scene, w, h, 5, d, |_| true);
+    let p = params(w, h, 5);
+    p.write(&scene.join("parameters.cfg")).unwrap();
+    write_pfm(&scene.join("gt_disp_lowres.pfm"), &Raster::from_vec(w, h, 1, vec![d as f32; w * h]).unwrap()).unwrap();
+    let config = root.path().join("plane.toml");
+    std::fs::write(&config, format!("scene = {:?}\n[stage1]\ndisparity_step = 0.1\n", scene.to_str().unwrap())).unwrap();
+    let out = root.path().join("result");
+
+    let (ok, stdout, stderr) = rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("stage 1 initialisation"), "{stdout}");
+
+    let disp = read_pfm(&out.join("disparity.pfm")).unwrap();
+    assert_eq!((disp.width, disp.height), (w, h));
+    let (mut err, mut n) = (0.0f64, 0);
+    for y in 4..h - 4 {
+        for x in 8..w - 8 {
+            err += (disp.get(x, y, 0) as f64 - d).abs();
+            n += 1;
+        }
+    }
+    assert!(err / n as f64 <= 0.02, "mean interior disparity error {}", err / n as f64);
+
+    let cam = Camera::from_parameters(&p);
+    let depth = read_pfm(&out.join("depth.pfm")).unwrap();
+    let (x, y) = (w / 2, h / 2);
+    let expected = cam.disparity_to_depth(disp.get(x, y, 0) as f64);
+    assert!((depth.get(x, y, 0) as f64 - expected).abs() < 1e-4 * expected);
+
+    let central = read_image(&out.join("central.png")).unwrap();
+    assert_eq!((central.width, central.height, central.channels), (w, h, 3));
+    assert!(!out.join("motion.toml").exists(), "global-shutter scene: no motion");
+    let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
+    let badpix_007 = metrics["disparity"]["badpix_percent"][0][1].as_f64().unwrap();
+    assert!(badpix_007 < 5.0, "BadPix(0.07) {badpix_007}%");
+}
+
+#[test]
+fn the_shipped_configs_parse() {
+    for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/configs")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            rslf::config::Config::read(&path).unwrap_or_else(|e| panic!("{e}"));
+        }
+    }
+}
+
+#[test]
+fn every_subcommand_has_help() {
+    for sub in ["train", "eval"] {
+        let (ok, stdout, _) = rslf(&[sub, "--help"]);
+        assert!(ok && stdout.contains("Usage: rslf"), "{sub}: {stdout}");
+    }
+}
