@@ -17,5 +17,6 @@ pub mod geometry;
 pub mod io;
 pub mod pipeline;
 pub mod progress;
+pub mod synth;
 
 pub use error::{Error, Result};

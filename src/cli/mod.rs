@@ -1,6 +1,7 @@
 //! The `rslf` command line: argument parsing and dispatch to the subcommands.
 
 mod eval;
+mod generate;
 mod train;
 
 use clap::{Parser, Subcommand};
@@ -19,6 +20,8 @@ pub struct Cli {
 pub enum Command {
     /// Fit a scene as a config describes and write the result folder.
     Train(train::TrainArgs),
+    /// Render a synthetic rolling-shutter light field with ground truth (one scene or the suite).
+    Generate(generate::GenerateArgs),
     /// Compare a result folder with a scene's ground truth; print and write metrics.json.
     Eval(eval::EvalArgs),
 }
@@ -28,5 +31,6 @@ pub fn run(cli: Cli) -> crate::Result<()> {
     match cli.command {
         Command::Train(args) => train::run(args),
         Command::Eval(args) => eval::run(args),
+        Command::Generate(args) => generate::run(args),
     }
 }

@@ -30,6 +30,10 @@ pub fn run(args: TrainArgs) -> crate::Result<()> {
         let stem = args.config.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned());
         PathBuf::from("results").join(stem)
     });
+    let scene_dir = match scene_dir.to_str().and_then(|s| s.strip_prefix(crate::synth::BUILTIN_PREFIX)) {
+        Some(name) => crate::synth::builtin_scene(name)?,
+        None => scene_dir,
+    };
     let scene = Scene::load(&scene_dir)?;
     let gt = GroundTruth::load(&scene_dir, scene.width(), scene.height())?;
     println!(

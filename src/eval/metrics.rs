@@ -194,7 +194,7 @@ mod tests {
         assert_eq!(m.pixels, 3); // zero truth skipped
         assert!((m.abs_diff_m - 2.5 / 3.0).abs() < 1e-12);
         assert!((m.rmse_m - ((0.25 + 4.0) / 3.0f64).sqrt()).abs() < 1e-12);
-        assert!((m.delta_1_25 - 2.0 / 3.0).abs() < 1e-12); // 2.5/2 = 1.25 is not < 1.25
+        assert!((m.delta_1_25 - 1.0 / 3.0).abs() < 1e-12); // 2.5/2 = 1.25 is not < 1.25, 4/2 = 2 neither
     }
 
     #[test]

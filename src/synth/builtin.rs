@@ -1,0 +1,48 @@
+//! Built-in scenes by name (`scene = "builtin:checkerboards_slow1"` in a config): suite entries
+//! generated into a cache folder the first time they are asked for.
+
+use super::scene_folder::{GenerateOptions, generate};
+use super::suite::suite;
+use crate::io::{IoError, IoResult};
+use std::path::PathBuf;
+
+/// The prefix that marks a built-in scene in a config's `scene`.
+pub const BUILTIN_PREFIX: &str = "builtin:";
+
+/// Folder of generated built-in scenes: `$RSLF_CACHE_DIR`, else `$XDG_CACHE_HOME/rslf`, else
+/// `~/.cache/rslf`.
+pub fn cache_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("RSLF_CACHE_DIR") {
+        return PathBuf::from(dir);
+    }
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))
+        .unwrap_or_else(|| PathBuf::from(".cache"));
+    base.join("rslf")
+}
+
+/// The folder of built-in scene `name` (a suite entry such as `checkerboards_slow1`), generated
+/// at its default size when not yet in the cache.
+pub fn builtin_scene(name: &str) -> IoResult<PathBuf> {
+    let dir = cache_dir().join("scenes").join(name);
+    if dir.join("parameters.cfg").exists() {
+        return Ok(dir);
+    }
+    let options = GenerateOptions::default();
+    let entries = suite(&options)?;
+    let entry = entries.iter().find(|e| e.name == name).ok_or_else(|| {
+        let names: Vec<&str> = entries.iter().map(|e| e.name.as_str()).collect();
+        IoError::new(format!("{BUILTIN_PREFIX}{name}"), format!("no such built-in scene (expected one of {})", names.join(", ")))
+    })?;
+    println!("generating built-in scene {name} into {} (once)", dir.display());
+    let bar = crate::progress::bar(81, "generating views");
+    let scene = generate(&entry.description, &options, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    })
+    .map_err(|e| IoError::new(&dir, e))?;
+    bar.finish_and_clear();
+    scene.write(&dir, true)?;
+    Ok(dir)
+}

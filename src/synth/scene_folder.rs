@@ -1,0 +1,113 @@
+//! Generating one scene and writing it as a FORMAT scene folder, whole or not at all.
+
+use super::description::SceneDescription;
+use super::render::Capture;
+use super::truth::{Truth, ground_truth};
+use super::world::World;
+use crate::geometry::Camera;
+use crate::io::{
+    IoError, IoResult, MotionRecord, Raster, SceneParameters, create_dir_all, view_file_name, write_mask_png, write_pfm,
+    write_png,
+};
+use std::path::Path;
+
+/// Overrides of a description for one generation.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct GenerateOptions {
+    /// Image size `[W, H]` instead of the description's.
+    pub size: Option<[usize; 2]>,
+    /// Seed mixed into every random choice (noise lattices, branch shapes).
+    pub seed: u64,
+}
+
+/// A generated light field with its ground truth, in memory.
+#[derive(Debug, Clone)]
+pub struct GeneratedScene {
+    /// Its `parameters.cfg`.
+    pub params: SceneParameters,
+    /// Every view, index order.
+    pub views: Vec<Raster>,
+    /// Ground truth.
+    pub truth: Truth,
+    /// The true motion.
+    pub motion: MotionRecord,
+}
+
+/// The camera and motion a description gives under `options` (disparity range left unset).
+pub fn capture_setup(desc: &SceneDescription, options: &GenerateOptions) -> Result<(SceneParameters, MotionRecord), String> {
+    let mut cam = desc.camera.clone();
+    if let Some(size) = options.size {
+        cam.size = size;
+    }
+    Ok((cam.parameters(None), desc.motion()?))
+}
+
+/// Renders every view of `desc` and its ground truth; `progress(done, total)` after each view.
+pub fn generate(
+    desc: &SceneDescription,
+    options: &GenerateOptions,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<GeneratedScene, String> {
+    let (mut params, motion) = capture_setup(desc, options)?;
+    let camera = Camera::from_parameters(&params);
+    let world = World::new(desc, options.seed);
+    let n = desc.render.supersampling;
+    let truth = ground_truth(&world, &camera, &motion, n);
+    let finite = truth.disparity.data.iter().filter(|d| d.is_finite());
+    let (lo, hi) = finite.fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), &d| (a.min(d), b.max(d)));
+    if lo.is_finite() && hi.is_finite() {
+        let margin = 0.1 * (hi - lo).max(1.0) as f64;
+        let round = |v: f64, up: bool| if up { (v * 10.0).ceil() / 10.0 } else { (v * 10.0).floor() / 10.0 };
+        params.disparity_range = Some((round(lo as f64 - margin, false), round(hi as f64 + margin, true)));
+    }
+    let capture = Capture::new(&world, &camera, &motion);
+    let total = camera.grid.len();
+    let views = (0..total)
+        .map(|i| {
+            let view = capture.render_view(camera.grid.view(i), n);
+            progress(i + 1, total);
+            view
+        })
+        .collect();
+    Ok(GeneratedScene { params, views, truth, motion })
+}
+
+impl GeneratedScene {
+    /// Writes the scene folder `out`: views, `parameters.cfg`, ground truth. The folder appears
+    /// only once complete; an existing `out` is replaced only when `replace` is set.
+    pub fn write(&self, out: &Path, replace: bool) -> IoResult<()> {
+        if out.exists() && !replace {
+            return Err(IoError::new(out, "already exists (pass --force to replace it)"));
+        }
+        let name = out.file_name().ok_or_else(|| IoError::new(out, "not a folder path"))?.to_string_lossy();
+        let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        create_dir_all(parent)?;
+        let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+        if tmp.exists() {
+            std::fs::remove_dir_all(&tmp).map_err(|e| IoError::os(&tmp, e))?;
+        }
+        let written = self.write_files(&tmp);
+        if let Err(e) = written {
+            let _ = std::fs::remove_dir_all(&tmp);
+            return Err(e);
+        }
+        if out.exists() {
+            std::fs::remove_dir_all(out).map_err(|e| IoError::os(out, e))?;
+        }
+        std::fs::rename(&tmp, out).map_err(|e| IoError::os(out, e))
+    }
+
+    fn write_files(&self, dir: &Path) -> IoResult<()> {
+        create_dir_all(dir)?;
+        for (i, view) in self.views.iter().enumerate() {
+            write_png(&dir.join(view_file_name(i)), view)?;
+        }
+        self.params.write(&dir.join("parameters.cfg"))?;
+        write_pfm(&dir.join("gt_disp_lowres.pfm"), &self.truth.disparity)?;
+        write_pfm(&dir.join("gt_depth_lowres.pfm"), &self.truth.depth)?;
+        write_png(&dir.join("gt_central.png"), &self.truth.central)?;
+        let (w, h) = (self.truth.depth.width, self.truth.depth.height);
+        write_mask_png(&dir.join("gt_mask.png"), &self.truth.mask, w, h)?;
+        self.motion.write(&dir.join("gt_motion.toml"))
+    }
+}
