@@ -11,12 +11,16 @@
 
 pub mod cli;
 pub mod config;
+pub mod device;
 pub mod error;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+pub mod model;
 pub mod pipeline;
 pub mod progress;
+pub mod random;
+pub mod render;
 pub mod synth;
 
 pub use error::{Error, Result};

@@ -37,7 +37,7 @@ fn assert_train_fails(scene: &Path, config: &Path, culprit: &str, problem: &str)
 
 #[test]
 fn missing_scene_folder() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (_, config) = valid_scene(root.path());
     let missing = root.path().join("nowhere");
     assert_train_fails(&missing, &config, "nowhere", "scene folder not found");
@@ -45,7 +45,7 @@ fn missing_scene_folder() {
 
 #[test]
 fn no_central_view() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     std::fs::remove_file(scene.join("input_Cam004.png")).unwrap();
     assert_train_fails(&scene, &config, "scene", "no central view (input_Cam004.png)");
@@ -53,7 +53,7 @@ fn no_central_view() {
 
 #[test]
 fn views_of_different_sizes() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     let small = rslf::io::Raster::zeros(12, 10, 3);
     rslf::io::write_png(&scene.join("input_Cam002.png"), &small).unwrap();
@@ -62,7 +62,7 @@ fn views_of_different_sizes() {
 
 #[test]
 fn corrupt_png() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     std::fs::write(scene.join("input_Cam003.png"), b"this is not a png").unwrap();
     assert_train_fails(&scene, &config, "input_Cam003.png", "unreadable PNG");
@@ -70,7 +70,7 @@ fn corrupt_png() {
 
 #[test]
 fn truncated_png() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     let path = scene.join("input_Cam005.png");
     let bytes = std::fs::read(&path).unwrap();
@@ -80,7 +80,7 @@ fn truncated_png() {
 
 #[test]
 fn corrupt_exr() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     std::fs::remove_file(scene.join("input_Cam001.png")).unwrap();
     std::fs::write(scene.join("input_Cam001.exr"), b"v/1\x01 definitely not an exr").unwrap();
@@ -89,7 +89,7 @@ fn corrupt_exr() {
 
 #[test]
 fn parameters_cfg_with_a_missing_key() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     let cfg = scene.join("parameters.cfg");
     let text = std::fs::read_to_string(&cfg).unwrap();
@@ -99,7 +99,7 @@ fn parameters_cfg_with_a_missing_key() {
 
 #[test]
 fn parameters_cfg_with_a_non_numeric_key() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     let cfg = scene.join("parameters.cfg");
     let text = std::fs::read_to_string(&cfg).unwrap().replace("baseline_mm = 10", "baseline_mm = ten");
@@ -109,7 +109,7 @@ fn parameters_cfg_with_a_non_numeric_key() {
 
 #[test]
 fn parameters_cfg_that_disagrees_with_the_views() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     let mut p = params(24, 20, 3);
     p.image_resolution_x_px = 32;
@@ -119,7 +119,7 @@ fn parameters_cfg_that_disagrees_with_the_views() {
 
 #[test]
 fn config_with_an_unknown_key() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     std::fs::write(&config, "[stage1]\niterations = 5\nlearning_rate = 0.1\n").unwrap();
     assert_train_fails(&scene, &config, "run.toml:3", "unknown field `learning_rate`");
@@ -127,7 +127,7 @@ fn config_with_an_unknown_key() {
 
 #[test]
 fn config_with_a_wrong_type() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, config) = valid_scene(root.path());
     std::fs::write(&config, "[motion]\nsegments = \"four\"\n").unwrap();
     assert_train_fails(&scene, &config, "run.toml:2: key `motion.segments`", "expected");
@@ -135,14 +135,14 @@ fn config_with_a_wrong_type() {
 
 #[test]
 fn missing_config() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, _) = valid_scene(root.path());
     assert_train_fails(&scene, &root.path().join("absent.toml"), "absent.toml", "no such file");
 }
 
 #[test]
 fn eval_with_a_truncated_pfm_names_it_and_writes_nothing() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, _) = valid_scene(root.path());
     let map = rslf::io::Raster::zeros(24, 20, 1);
     rslf::io::write_pfm(&scene.join("gt_disp_lowres.pfm"), &map).unwrap();
@@ -159,7 +159,7 @@ fn eval_with_a_truncated_pfm_names_it_and_writes_nothing() {
 
 #[test]
 fn eval_of_a_scene_without_ground_truth_says_so() {
-    let root = tempfile::tempdir().unwrap();
+    let root = common::tempdir();
     let (scene, _) = valid_scene(root.path());
     let result = root.path().join("result");
     std::fs::create_dir(&result).unwrap();

@@ -83,7 +83,7 @@ fn hci_ground_truth_pfm_reads_as_a_512x512_map_in_the_scene_range() {
 
 #[test]
 fn pfm_round_trips_hci_ground_truth_bit_exactly() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     let gt = read_pfm(&hci("antinous").join("gt_disp_lowres.pfm")).unwrap();
     let path = dir.path().join("copy.pfm");
     rslf::io::write_pfm(&path, &gt).unwrap();
@@ -95,7 +95,7 @@ fn pfm_round_trips_hci_ground_truth_bit_exactly() {
 #[test]
 fn eval_of_antinous_ground_truth_against_itself_is_perfect() {
     let scene = hci("antinous");
-    let result = tempfile::tempdir().unwrap();
+    let result = common::tempdir();
     std::fs::copy(scene.join("gt_disp_lowres.pfm"), result.path().join("disparity.pfm")).unwrap();
     let (ok, stdout, stderr) = rslf(&["eval", "--scene", scene.to_str().unwrap(), "--result", result.path().to_str().unwrap()]);
     assert!(ok, "{stderr}");

@@ -8,7 +8,7 @@ use rslf::io::{Scene, read_image};
 
 #[test]
 fn png_bit_depths_and_channels_are_scaled_to_unit_range() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     let p = |n: &str| dir.path().join(n);
     image::GrayImage::from_fn(3, 2, |x, _| image::Luma([(x * 127) as u8])).save(p("g8.png")).unwrap();
     image::ImageBuffer::<image::Luma<u16>, _>::from_fn(3, 2, |x, _| image::Luma([(x * 32767) as u16]))
@@ -33,7 +33,7 @@ fn png_bit_depths_and_channels_are_scaled_to_unit_range() {
 
 #[test]
 fn exr_views_keep_their_linear_values() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     let path = dir.path().join("input_Cam000.exr");
     exr::prelude::write_rgb_file(&path, 4, 3, |x, y| (x as f32 * 2.5, y as f32, -0.25f32)).unwrap();
     let img = read_image(&path).unwrap();
@@ -43,7 +43,7 @@ fn exr_views_keep_their_linear_values() {
 
 #[test]
 fn a_scene_of_exr_views_loads_like_png() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     for i in 0..9 {
         let v = i as f32;
         exr::prelude::write_rgb_file(dir.path().join(format!("input_Cam{i:03}.exr")), 5, 4, |_, _| (v, v, v)).unwrap();
@@ -55,7 +55,7 @@ fn a_scene_of_exr_views_loads_like_png() {
 
 #[test]
 fn missing_views_are_left_empty_and_the_rest_used() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     // The 33-view pattern of HCI's cotton on a 5x5 grid: central row, column and diagonals.
     let keep = |i: usize| {
         let (r, c) = (i / 5, i % 5);
@@ -72,7 +72,7 @@ fn missing_views_are_left_empty_and_the_rest_used() {
 
 #[test]
 fn without_parameters_the_grid_is_the_smallest_square_holding_every_view() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     write_plane_scene(dir.path(), 8, 8, 5, 0.0, |i| i == 12 || i == 24);
     let scene = Scene::load(dir.path()).unwrap();
     assert_eq!(scene.grid, ViewGrid { rows: 5, cols: 5 });
@@ -81,7 +81,7 @@ fn without_parameters_the_grid_is_the_smallest_square_holding_every_view() {
 
 #[test]
 fn a_view_outside_the_configured_grid_is_refused() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     write_plane_scene(dir.path(), 8, 8, 5, 0.0, |i| i == 4 || i == 12);
     params(8, 8, 3).write(&dir.path().join("parameters.cfg")).unwrap();
     let err = Scene::load(dir.path()).unwrap_err();
@@ -91,7 +91,7 @@ fn a_view_outside_the_configured_grid_is_refused() {
 
 #[test]
 fn grey_and_rgb_views_cannot_be_mixed() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = common::tempdir();
     write_plane_scene(dir.path(), 8, 8, 3, 0.0, |_| true);
     rslf::io::write_png(&dir.path().join("input_Cam007.png"), &rslf::io::Raster::zeros(8, 8, 1)).unwrap();
     let err = Scene::load(dir.path()).unwrap_err();

@@ -11,8 +11,8 @@ pub struct GenerateArgs {
     #[arg(required_unless_present = "suite", conflicts_with = "suite")]
     pub scene: Option<PathBuf>,
     /// Output folder: the scene folder, or with --suite the folder of all suite scenes.
-    #[arg(long)]
-    pub out: PathBuf,
+    #[arg(long, required_unless_present = "list")]
+    pub out: Option<PathBuf>,
     /// Generate the whole built-in suite (every base scene: static, 5 slow, 5 fast motions).
     #[arg(long)]
     pub suite: bool,
@@ -25,6 +25,9 @@ pub struct GenerateArgs {
     /// Replace scene folders that already exist.
     #[arg(long)]
     pub force: bool,
+    /// With --suite: print the scenes and their motions without rendering anything.
+    #[arg(long, requires = "suite")]
+    pub list: bool,
 }
 
 fn parse_size(s: &str) -> Result<[usize; 2], String> {
@@ -61,26 +64,34 @@ pub fn run(args: GenerateArgs) -> crate::Result<()> {
     let options = GenerateOptions { size: args.size, seed: args.seed };
     if args.suite {
         let entries = suite(&options)?;
-        println!("suite: {} scenes into {}", entries.len(), args.out.display());
+        match &args.out {
+            Some(out) if !args.list => println!("suite: {} scenes into {}", entries.len(), out.display()),
+            _ => println!("suite: {} scenes", entries.len()),
+        }
         for entry in &entries {
-            let out = args.out.join(&entry.name);
-            let seconds = one(&entry.description, &options, &out, args.force)?;
+            let timing = match (&args.out, args.list) {
+                (Some(out), false) => format!("  [{:.1} s]", one(&entry.description, &options, &out.join(&entry.name), args.force)?),
+                _ => String::new(),
+            };
             let motion = entry.description.motion().map_err(crate::Error::Usage)?;
             let groups = motion.groups();
+            let round = |v: &[f64]| v.iter().map(|x| (x * 1e4).round() / 1e4).collect::<Vec<_>>();
             println!(
-                "{:<22} {:<6} max shift {:>5.2} px  omega {:?} rad/s  v {:?} m/s  [{seconds:.1} s]",
+                "{:<22} {:<6} max shift {:>5.2} px  omega {:?} rad/s  v {:?} m/s{timing}",
                 entry.name,
                 entry.category,
                 entry.max_shift_px,
-                groups[0].1.iter().map(|x| (x * 1e4).round() / 1e4).collect::<Vec<_>>(),
-                groups[1].1.iter().map(|x| (x * 1e4).round() / 1e4).collect::<Vec<_>>(),
+                round(&groups[0].1),
+                round(&groups[1].1),
             );
         }
         return Ok(());
     }
-    let path = args.scene.expect("clap requires SCENE without --suite");
+    let (Some(path), Some(out)) = (args.scene, args.out) else {
+        return Err(crate::Error::Usage("rslf generate needs SCENE.toml and --out DIR (or --suite)".into()));
+    };
     let description = SceneDescription::read(&path)?;
-    let seconds = one(&description, &options, &args.out, args.force)?;
-    println!("wrote {} ({} views rendered in {seconds:.1} s)", args.out.display(), description.camera.num_cams.pow(2));
+    let seconds = one(&description, &options, &out, args.force)?;
+    println!("wrote {} ({} views rendered in {seconds:.1} s)", out.display(), description.camera.num_cams.pow(2));
     Ok(())
 }

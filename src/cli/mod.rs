@@ -1,5 +1,6 @@
 //! The `rslf` command line: argument parsing and dispatch to the subcommands.
 
+mod bench;
 mod eval;
 mod generate;
 mod train;
@@ -22,6 +23,8 @@ pub enum Command {
     Train(train::TrainArgs),
     /// Render a synthetic rolling-shutter light field with ground truth (one scene or the suite).
     Generate(generate::GenerateArgs),
+    /// Time the renderer (flex, wgpu) and stage 1; print peak memory.
+    Bench(bench::BenchArgs),
     /// Compare a result folder with a scene's ground truth; print and write metrics.json.
     Eval(eval::EvalArgs),
 }
@@ -31,6 +34,7 @@ pub fn run(cli: Cli) -> crate::Result<()> {
     match cli.command {
         Command::Train(args) => train::run(args),
         Command::Eval(args) => eval::run(args),
+        Command::Bench(args) => bench::run(args),
         Command::Generate(args) => generate::run(args),
     }
 }

@@ -3,6 +3,7 @@
 use crate::config::Config;
 use crate::eval::evaluate;
 use crate::io::{GroundTruth, Scene};
+use crate::model::SavedModel;
 use crate::pipeline;
 use std::path::PathBuf;
 
@@ -17,6 +18,9 @@ pub struct TrainArgs {
     /// Result folder; overrides the config's `out`.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Folder of saved models; the fitted model goes to MODELS/<result folder name>/model.json.
+    #[arg(long, default_value = "models")]
+    pub models: PathBuf,
 }
 
 /// Loads config and scene, runs the pipeline, writes the result folder (and `metrics.json`
@@ -50,12 +54,21 @@ pub fn run(args: TrainArgs) -> crate::Result<()> {
             (Some(_), false) => "global shutter".to_string(),
         }
     );
-    let (result, log) = pipeline::run(&config, &scene);
+    let device = crate::device::device(config.device);
+    let (result, log) = pipeline::run(&config, &scene, &device);
     for line in &log.lines {
         println!("{line}");
     }
     let written = result.write(&out, scene.camera().as_ref())?;
     for path in &written {
+        println!("wrote {}", path.display());
+    }
+    if let Some(gaussians) = &result.gaussians {
+        let name = out.file_name().map_or("run".into(), |n| n.to_string_lossy().into_owned());
+        let size = [scene.width(), scene.height()];
+        let grid = [scene.grid.rows, scene.grid.cols];
+        let model = SavedModel::new(&scene_dir, size, grid, gaussians.clone(), result.motion.as_ref());
+        let path = model.save(&args.models.join(name))?;
         println!("wrote {}", path.display());
     }
     if !gt.is_empty() {

@@ -110,6 +110,28 @@ impl Config {
                 return fail("stage1.disparity_range", "has more than 100000 candidates at this disparity_step");
             }
         }
+        for (key, lr) in [
+            ("stage1.lr_position", self.stage1.lr_position),
+            ("stage1.lr_disparity", self.stage1.lr_disparity),
+            ("stage1.lr_size", self.stage1.lr_size),
+            ("stage1.lr_colour", self.stage1.lr_colour),
+        ] {
+            if !(lr >= 0.0 && lr.is_finite()) {
+                return fail(key, "must be a finite number >= 0");
+            }
+        }
+        if !(self.stage1.adam_epsilon > 0.0 && self.stage1.adam_epsilon.is_finite()) {
+            return fail("stage1.adam_epsilon", "must be a positive number");
+        }
+        if !(1..=256).contains(&self.render.max_per_pixel) {
+            return fail("render.max_per_pixel", "must be 1 to 256");
+        }
+        if !(self.render.cutoff_sigma > 0.0 && self.render.cutoff_sigma <= 10.0) {
+            return fail("render.cutoff_sigma", "must be in (0, 10]");
+        }
+        if self.stage1.band_height == 0 {
+            return fail("stage1.band_height", "must be at least 1 row");
+        }
         if self.stage2.band_height == 0 {
             return fail("stage2.band_height", "must be at least 1 row");
         }

@@ -6,11 +6,17 @@
 //! handled by keeping the better of the two half-rows (views left of centre, views right of
 //! centre): a point hidden on one side is usually visible on the other. Costs are averaged over
 //! a square window, the best candidate is refined to sub-pixel precision by a parabola, and the
-//! depth of the cost minimum is kept as a confidence.
+//! depth of the cost minimum below the mean cost of all candidates is kept as a confidence. Where the cost curve is flat (uniform
+//! regions wider than the window) the minimum means nothing: those pixels take the disparity of
+//! the nearest confident pixels left, right, above and below, weighted by inverse distance.
 
 use crate::geometry::ViewId;
 use crate::io::{Raster, Scene};
 use rayon::prelude::*;
+
+/// Depth of the cost minimum (mean absolute intensity difference) under which a pixel's sweep
+/// result is not trusted and is filled from its confident neighbours.
+pub const MIN_CONFIDENCE: f32 = 2e-3;
 
 /// Settings of the sweep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -28,7 +34,8 @@ pub struct PlaneSweepSettings {
 pub struct DisparityEstimate {
     /// Disparity of the central view, pixels (FORMAT sign).
     pub disparity: Raster,
-    /// How much lower the chosen cost is than its neighbours' (intensity units; higher = surer).
+    /// Mean cost over all candidates minus the chosen cost (intensity units; higher = surer;
+    /// near 0 where the cost curve is flat).
     pub confidence: Raster,
 }
 
@@ -119,6 +126,7 @@ pub fn plane_sweep(
     let mut before = vec![f32::INFINITY; n];
     let mut after = vec![f32::INFINITY; n];
     let mut previous = vec![f32::INFINITY; n];
+    let mut total = vec![(0.0f32, 0u32); n];
     let (mut cl, mut cr) = (vec![0.0f32; n], vec![0.0f32; n]);
     for l in 0..labels {
         let d = (lo + l as f64 * settings.step) as f32;
@@ -130,8 +138,13 @@ pub fn plane_sweep(
             .zip(before.par_iter_mut())
             .zip(after.par_iter_mut())
             .zip(previous.par_iter_mut())
+            .zip(total.par_iter_mut())
             .zip(cost.par_iter())
-            .for_each(|((((b, bf), af), prev), &c)| {
+            .for_each(|(((((b, bf), af), prev), tot), &c)| {
+                if c.is_finite() {
+                    tot.0 += c;
+                    tot.1 += 1;
+                }
                 if b.1 + 1 == l && l > 0 {
                     *af = c;
                 }
@@ -156,12 +169,69 @@ pub fn plane_sweep(
             }
         }
         disparity.data[i] = (lo + (l as f64 + offset) * settings.step) as f32;
-        let neighbours = [cm, cp].into_iter().filter(|c| c.is_finite()).collect::<Vec<_>>();
-        confidence.data[i] = if c0.is_finite() && !neighbours.is_empty() {
-            (neighbours.iter().sum::<f32>() / neighbours.len() as f32 - c0).max(0.0)
-        } else {
-            0.0
-        };
+        let (sum, count) = total[i];
+        confidence.data[i] = if c0.is_finite() && count > 0 { (sum / count as f32 - c0).max(0.0) } else { 0.0 };
     }
+    let confident: Vec<bool> = confidence.data.iter().map(|&c| c >= MIN_CONFIDENCE).collect();
+    fill_unconfident(&mut disparity, &confident);
     DisparityEstimate { disparity, confidence }
+}
+
+/// Replaces every pixel not `confident` by the inverse-distance-weighted mean of the nearest
+/// confident pixel in each of the four axis directions (left as is when there is none).
+pub fn fill_unconfident(map: &mut Raster, confident: &[bool]) {
+    let (w, h) = (map.width, map.height);
+    let mut sum = vec![0.0f64; w * h];
+    let mut weight = vec![0.0f64; w * h];
+    let mut add = |i: usize, value: f32, dist: usize| {
+        let wt = 1.0 / dist as f64;
+        sum[i] += wt * value as f64;
+        weight[i] += wt;
+    };
+    // Each scan carries the last confident value and its position along a line.
+    for y in 0..h {
+        let mut last: Option<(f32, usize)> = None;
+        for x in 0..w {
+            let i = y * w + x;
+            if confident[i] { last = Some((map.data[i], x)) } else if let Some((v, at)) = last { add(i, v, x - at) }
+        }
+        last = None;
+        for x in (0..w).rev() {
+            let i = y * w + x;
+            if confident[i] { last = Some((map.data[i], x)) } else if let Some((v, at)) = last { add(i, v, at - x) }
+        }
+    }
+    for x in 0..w {
+        let mut last: Option<(f32, usize)> = None;
+        for y in 0..h {
+            let i = y * w + x;
+            if confident[i] { last = Some((map.data[i], y)) } else if let Some((v, at)) = last { add(i, v, y - at) }
+        }
+        last = None;
+        for y in (0..h).rev() {
+            let i = y * w + x;
+            if confident[i] { last = Some((map.data[i], y)) } else if let Some((v, at)) = last { add(i, v, at - y) }
+        }
+    }
+    for i in 0..w * h {
+        if !confident[i] && weight[i] > 0.0 {
+            map.data[i] = (sum[i] / weight[i]) as f32;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unconfident_pixels_take_their_confident_neighbours_values() {
+        // A 5x1 row: confident 1.0 at x = 0 and 3.0 at x = 4; the middle is filled by distance.
+        let mut map = Raster::from_vec(5, 1, 1, vec![1.0, -9.0, -9.0, -9.0, 3.0]).unwrap();
+        fill_unconfident(&mut map, &[true, false, false, false, true]);
+        assert_eq!(map.data[0], 1.0);
+        assert!((map.data[2] - 2.0).abs() < 1e-6);
+        assert!((map.data[1] - (1.0 + 3.0 / 3.0) / (1.0 + 1.0 / 3.0)).abs() < 1e-6);
+        assert_eq!(map.data[4], 3.0);
+    }
 }

@@ -2,7 +2,8 @@
 //! whole or not at all.
 
 use crate::geometry::Camera;
-use crate::io::{IoResult, MotionRecord, Raster, create_dir_all, write_pfm, write_png};
+use crate::io::{IoResult, MotionRecord, Raster, create_dir_all, write_atomic, write_pfm, write_png};
+use crate::model::GaussianSet;
 use std::path::{Path, PathBuf};
 
 /// What a run produced, ready to be written.
@@ -14,6 +15,10 @@ pub struct RunResult {
     pub central: Raster,
     /// The estimated motion, when one was estimated.
     pub motion: Option<MotionRecord>,
+    /// The fitted Gaussians, when a model was fitted.
+    pub gaussians: Option<GaussianSet>,
+    /// Loss per step, per stage: `(stage name, values)`.
+    pub curves: Vec<(String, Vec<f32>)>,
 }
 
 /// Depth of every pixel of a disparity map; NaN where the disparity is at or beyond infinity.
@@ -48,6 +53,12 @@ impl RunResult {
         put("central.png", &|p| write_png(p, &self.central))?;
         if let Some(m) = &self.motion {
             put("motion.toml", &|p| m.write(p))?;
+        }
+        for (stage, curve) in &self.curves {
+            let csv: String = std::iter::once("step,loss\n".to_string())
+                .chain(curve.iter().enumerate().map(|(i, l)| format!("{},{l}\n", i + 1)))
+                .collect();
+            put(&format!("loss_{stage}.csv"), &|p| write_atomic(p, csv.as_bytes()))?;
         }
         Ok(written)
     }

@@ -4,7 +4,6 @@
 
 mod builtin;
 mod description;
-mod random;
 mod render;
 mod scene_folder;
 mod shapes;

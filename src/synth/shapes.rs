@@ -3,7 +3,7 @@
 //! Rays are `o + t d` with `d` not necessarily unit; the returned `t` is in those units, so it
 //! stays valid after the rigid transform that placed the object.
 
-use super::random::Rng;
+use crate::random::Rng;
 use nalgebra::{Point3, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -218,10 +218,21 @@ impl Shape {
                 });
                 side.into_iter().chain(caps).min_by(|a, b| a.t.total_cmp(&b.t))
             }
-            Shape::Branches { radius, .. } => segments
-                .iter()
-                .filter_map(|s| segment_cylinder_t(o, d, s, *radius))
-                .min_by(|a, b| a.t.total_cmp(&b.t)),
+            Shape::Branches { radius, .. } => {
+                let d2 = d.norm_squared();
+                segments
+                    .iter()
+                    .filter(|s| {
+                        // Cheap rejection: the ray must pass the segment's bounding sphere.
+                        let centre = Point3::from((s.a.coords + s.b.coords) * 0.5);
+                        let bound = (s.b - s.a).norm() * 0.5 + radius;
+                        let oc = o - centre;
+                        let b = oc.dot(d);
+                        b * b - d2 * (oc.norm_squared() - bound * bound) >= 0.0
+                    })
+                    .filter_map(|s| segment_cylinder_t(o, d, s, *radius))
+                    .min_by(|a, b| a.t.total_cmp(&b.t))
+            }
         }
     }
 

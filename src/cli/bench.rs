@@ -1,0 +1,116 @@
+//! `rslf bench`: the renderer's and stage 1's speed and memory, printed.
+
+use crate::config::{Config, DeviceChoice};
+use crate::io::Scene;
+use crate::model::GaussianSet;
+use crate::random::Rng;
+use crate::render::{RenderSettings, bins_for_view, render};
+use crate::synth::{GenerateOptions, base_scene, generate};
+use std::time::Instant;
+
+/// Arguments of `rslf bench`.
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// Image side, pixels.
+    #[arg(long, default_value_t = 512)]
+    pub size: usize,
+    /// Number of Gaussians.
+    #[arg(long, default_value_t = 20_000)]
+    pub gaussians: usize,
+    /// Timed repetitions of each render.
+    #[arg(long, default_value_t = 3)]
+    pub repeat: usize,
+    /// Devices to time, comma separated (`flex`, `wgpu`).
+    #[arg(long, default_value = "flex,wgpu", value_delimiter = ',')]
+    pub devices: Vec<DeviceChoice>,
+    /// Skip the whole-stage-1 timing.
+    #[arg(long)]
+    pub render_only: bool,
+}
+
+/// Peak resident memory of this process so far, MiB (Linux), if known.
+fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+fn random_set(n: usize, size: usize, seed: u64) -> GaussianSet {
+    let mut rng = Rng::new(seed);
+    let spacing = ((size * size) as f64 / n as f64).sqrt();
+    let mut set = GaussianSet { u: vec![], v: vec![], disparity: vec![], size: vec![], colour: vec![], channels: 3 };
+    for _ in 0..n {
+        set.u.push(rng.range(0.0, size as f64) as f32);
+        set.v.push(rng.range(0.0, size as f64) as f32);
+        set.disparity.push(rng.range(-2.0, 2.0) as f32);
+        set.size.push((spacing * rng.range(0.4, 0.8)) as f32);
+        set.colour.extend((0..3).map(|_| rng.unit() as f32));
+    }
+    set
+}
+
+/// Times the renderer on each device, then the whole stage 1 on flex.
+pub fn run(args: BenchArgs) -> crate::Result<()> {
+    let (n, s) = (args.gaussians.max(1), args.size.max(8));
+    let set = random_set(n, s, 1);
+    let settings = RenderSettings::default();
+    let offset = (-2.0, 0.0);
+    println!("render: {s}x{s} px, {n} Gaussians, K = {}, view offset {offset:?}", settings.max_per_pixel);
+    for &choice in &args.devices {
+        let device = crate::device::device(choice);
+        let start = Instant::now();
+        let bins = bins_for_view(&set, offset, s, 0..s, &settings);
+        let binning = start.elapsed().as_secs_f64();
+        let g = set.to_module(&device);
+        let mut times = Vec::new();
+        for _ in 0..args.repeat.max(1) + 1 {
+            let start = Instant::now();
+            let out = render(&g, offset, &bins, &device);
+            let loss = out.colour.mean() + out.disparity.mean();
+            let grads = loss.backward();
+            let grad = g.centre.val().grad(&grads).map(|t| t.sum().into_scalar::<f32>());
+            times.push(start.elapsed().as_secs_f64());
+            if grad.is_none_or(|v| !v.is_finite()) {
+                return Err(crate::Error::Usage(format!("{choice:?}: the gradient did not come back finite")));
+            }
+        }
+        times.remove(0); // the first run warms caches and compiles kernels
+        let best = times.iter().copied().fold(f64::INFINITY, f64::min);
+        let mean = times.iter().sum::<f64>() / times.len() as f64;
+        println!(
+            "  {choice:?}: forward+backward {:.0} ms (best {:.0} ms of {}), binning {:.0} ms, {:.1}% pixels with K full",
+            mean * 1e3,
+            best * 1e3,
+            times.len(),
+            binning * 1e3,
+            100.0 * bins.saturated_fraction()
+        );
+    }
+    if !args.render_only {
+        let start = Instant::now();
+        let mut desc = base_scene("objects")?;
+        desc.camera.num_cams = 9;
+        let scene = generate(&desc, &GenerateOptions { size: Some([s, s]), seed: 0 }, |_, _| {}).map_err(crate::Error::Usage)?;
+        let generated = start.elapsed().as_secs_f64();
+        let dir = std::env::temp_dir().join(format!("rslf-bench-{}", std::process::id()));
+        scene.write(&dir, true)?;
+        let loaded = Scene::load(&dir);
+        let _ = std::fs::remove_dir_all(&dir);
+        let loaded = loaded?;
+        let mut config = Config::default();
+        config.stage1.gaussians = n;
+        let device = crate::device::device(DeviceChoice::Flex);
+        let start = Instant::now();
+        let (_, log) = crate::pipeline::run(&config, &loaded, &device);
+        println!("stage 1 on the generated `objects` scene ({s}x{s}, 81 views generated in {generated:.1} s), flex:");
+        for line in log.lines {
+            println!("  {line}");
+        }
+        println!("  whole stage 1: {:.1} s", start.elapsed().as_secs_f64());
+    }
+    if let Some(mib) = peak_rss_mib() {
+        println!("peak memory of this process: {mib:.0} MiB");
+    }
+    Ok(())
+}

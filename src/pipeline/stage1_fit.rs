@@ -1,0 +1,119 @@
+//! Stage-1 fit: Adam on every Gaussian parameter against views of the central row (which hold no
+//! motion), one learning rate per parameter group.
+
+use crate::geometry::ViewId;
+use crate::io::{Raster, Scene};
+use crate::model::Gaussians;
+use crate::render::{RenderSettings, bins_for_view, render};
+use burn::module::ParamGroup;
+use burn::optim::lr_scheduler::LrSchedulerConfig;
+use burn::optim::lr_scheduler::module_lr_scheduler::{ModuleLrScheduler, ModuleLrSchedulerConfig};
+use burn::optim::{AdamConfig, GradientsParams};
+use burn::tensor::{Device, Tensor, TensorData};
+
+/// Learning rates of the four parameter groups (units of the parameter per step).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LearningRates {
+    /// Centres, pixels.
+    pub position: f64,
+    /// Disparity, pixels.
+    pub disparity: f64,
+    /// `ln σ`.
+    pub size: f64,
+    /// Colour.
+    pub colour: f64,
+}
+
+/// Settings of the stage-1 fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stage1Fit {
+    /// Adam steps; each renders one band of rows in every view, bands taken in turn.
+    pub iterations: usize,
+    /// Rows per band.
+    pub band_height: usize,
+    /// Learning rates.
+    pub lr: LearningRates,
+    /// Adam's epsilon. Near 0 Adam steps by the sign of the gradient, so parameters with
+    /// noise-level gradients (disparity in flat regions) random-walk at the full rate.
+    pub adam_epsilon: f32,
+    /// Renderer settings.
+    pub render: RenderSettings,
+}
+
+/// A view's pixels as a `[P, C]` tensor.
+pub fn image_tensor(img: &Raster, device: &Device) -> Tensor<2> {
+    Tensor::from_data(TensorData::new(img.data.clone(), [img.pixels(), img.channels]), device)
+}
+
+/// Rows `rows` of a view as a `[P, C]` tensor.
+fn band_tensor(img: &Raster, rows: std::ops::Range<usize>, device: &Device) -> Tensor<2> {
+    let (w, c) = (img.width, img.channels);
+    let data = img.data[rows.start * w * c..rows.end * w * c].to_vec();
+    Tensor::from_data(TensorData::new(data, [rows.len() * w, c]), device)
+}
+
+/// The per-group learning-rate policy of `g`.
+fn lr_policy(g: &Gaussians, lr: &LearningRates) -> ModuleLrScheduler {
+    let group = |id| ParamGroup::from_ids(vec![id]);
+    ModuleLrSchedulerConfig::new(LrSchedulerConfig::Constant(lr.position))
+        .with_group(group(g.centre.id), LrSchedulerConfig::Constant(lr.position))
+        .with_group(group(g.disparity.id), LrSchedulerConfig::Constant(lr.disparity))
+        .with_group(group(g.log_size.id), LrSchedulerConfig::Constant(lr.size))
+        .with_group(group(g.colour.id), LrSchedulerConfig::Constant(lr.colour))
+        .init()
+        .expect("constant schedules are valid")
+}
+
+/// Fits `g` to `views` of `scene`; returns the fitted Gaussians and the L1 loss of each step.
+/// Each step renders the same band of rows in every view (the views of the central row see a
+/// point on the same row), so that every step weighs all the disparity cues; bands are taken
+/// in turn. `progress(step, total, loss)` is called after each step.
+pub fn fit_stage1(
+    mut g: Gaussians,
+    scene: &Scene,
+    views: &[ViewId],
+    fit: &Stage1Fit,
+    device: &Device,
+    mut progress: impl FnMut(usize, usize, f32),
+) -> (Gaussians, Vec<f32>) {
+    let (w, h) = (scene.width(), scene.height());
+    assert!(!views.is_empty(), "stage 1 needs at least one view");
+    let targets: Vec<((f32, f32), &Raster)> = views
+        .iter()
+        .filter_map(|&v| {
+            let (dx, dy) = scene.grid.offset(v);
+            Some(((dx as f32, dy as f32), scene.view(v)?))
+        })
+        .collect();
+    let band = fit.band_height.clamp(1, h);
+    let bands: Vec<std::ops::Range<usize>> = (0..h).step_by(band).map(|y| y..(y + band).min(h)).collect();
+    // Band targets are cut once: `[P, C]` per (band, view).
+    let band_targets: Vec<Vec<Tensor<2>>> = bands
+        .iter()
+        .map(|rows| targets.iter().map(|(_, img)| band_tensor(img, rows.clone(), device)).collect())
+        .collect();
+    let mut optim = AdamConfig::new().with_epsilon(fit.adam_epsilon).init();
+    let mut schedule = lr_policy(&g, &fit.lr);
+    let mut curve = Vec::with_capacity(fit.iterations);
+    for step in 0..fit.iterations {
+        let b = step % bands.len();
+        let set = g.to_set();
+        let mut loss: Option<Tensor<1>> = None;
+        for ((offset, _), target) in targets.iter().zip(&band_targets[b]) {
+            let bins = bins_for_view(&set, *offset, w, bands[b].clone(), &fit.render);
+            let out = render(&g, *offset, &bins, device);
+            let term = (out.colour - target.clone()).abs().mean();
+            loss = Some(match loss {
+                Some(l) => l + term,
+                None => term,
+            });
+        }
+        let loss = loss.expect("at least one view") / targets.len() as f32;
+        let value = loss.clone().into_scalar::<f32>();
+        let grads = GradientsParams::from_grads(loss.backward(), &g);
+        g = optim.step(schedule.step(), g, grads);
+        curve.push(value);
+        progress(step + 1, fit.iterations, value);
+    }
+    (g, curve)
+}

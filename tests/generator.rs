@@ -1,0 +1,152 @@
+//! `rslf generate` obeys FORMAT: checked the way real data is checked, on scenes it makes.
+
+mod common;
+
+use common::{rslf, tempdir};
+use rslf::geometry::{Camera, ViewId, rs_project};
+use rslf::io::{GroundTruth, MotionRecord, Raster, Scene};
+use rslf::synth::{FAST_PX, GenerateOptions, SLOW_PX, SceneDescription, base_scene, generate, suite};
+use std::path::Path;
+
+/// A base scene at `size` px and a 5x5 grid, with `motion`, written to `dir`.
+fn small_scene(dir: &Path, name: &str, size: usize, motion: Option<&MotionRecord>) -> Scene {
+    let mut desc: SceneDescription = base_scene(name).unwrap();
+    desc.camera.num_cams = 5;
+    desc.motion = motion.map(|m| toml::from_str(&m.to_toml_string()).unwrap());
+    let options = GenerateOptions { size: Some([size, size]), seed: 0 };
+    generate(&desc, &options, |_, _| {}).unwrap().write(dir, false).unwrap();
+    Scene::load(dir).unwrap()
+}
+
+fn warp_error(scene: &Scene, gt: &Raster, view: ViewId, sign: f64) -> f64 {
+    let central = scene.central();
+    let img = scene.view(view).unwrap();
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for y in 8..central.height - 8 {
+        for x in 8..central.width - 8 {
+            let d = sign * gt.get(x, y, 0) as f64;
+            let (xs, ys) = scene.grid.position_in_view(view, x as f64, y as f64, d);
+            for ch in 0..3 {
+                if let Some(s) = img.sample_bilinear(xs as f32, ys as f32, ch) {
+                    sum += (s - central.get(x, y, ch)).abs() as f64;
+                    n += 1;
+                }
+            }
+        }
+    }
+    sum / n as f64
+}
+
+#[test]
+fn a_static_scene_warps_onto_its_central_view_with_its_ground_truth_disparity() {
+    let dir = tempdir();
+    let scene = small_scene(&dir.path().join("s"), "objects", 256, None);
+    let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
+    let disparity = gt.disparity.unwrap();
+    for view in scene.grid.corners() {
+        let (right, wrong) = (warp_error(&scene, &disparity, view, 1.0), warp_error(&scene, &disparity, view, -1.0));
+        eprintln!("view {view:?}: warp error {right:.4} (FORMAT sign), {wrong:.4} (opposite)");
+        // What remains is resampling of fine textures and disoccluded pixels; it halves from 128 to 256 px.
+        assert!(right < 0.025, "view {view:?}: warp error {right}");
+        assert!(wrong > 3.0 * right, "view {view:?}: {right} with the FORMAT sign, {wrong} with the opposite");
+    }
+    assert!(gt.mask.unwrap().iter().all(|&m| m), "static scene: every ground-truth pixel is visible");
+    assert_eq!(gt.motion, Some(MotionRecord::zero()));
+}
+
+#[test]
+fn moving_ground_truth_points_land_on_the_rolling_shutter_central_view() {
+    let dir = tempdir();
+    let motion = MotionRecord::ConstantVelocity { omega_rad_s: [0.1, 0.25, -0.2], velocity_m_s: [0.6, -0.3, 0.5] };
+    const S: usize = 256;
+    let scene = small_scene(&dir.path().join("m"), "checkerboards", S, Some(&motion));
+    let cam: Camera = scene.camera().unwrap();
+    assert!(scene.is_rolling_shutter());
+    let gt = GroundTruth::load(&scene.dir, S, S).unwrap();
+    assert_eq!(gt.motion.as_ref(), Some(&motion));
+    let (depth, central0, mask) = (gt.depth.unwrap(), gt.central.unwrap(), gt.mask.unwrap());
+    let rs = scene.central();
+    let centre = scene.central_id();
+    let (mut moved, mut unmoved, mut n, mut shift) = (0.0f64, 0.0f64, 0usize, 0.0f64);
+    for v in 4..S - 4 {
+        for u in 4..S - 4 {
+            if !mask[v * S + u] {
+                continue;
+            }
+            let p0 = cam.back_project(u as f64, v as f64, depth.get(u, v, 0) as f64);
+            let (x, y, _) = rs_project(&cam, &motion, centre, &p0).unwrap();
+            shift = shift.max(((x - u as f64).powi(2) + (y - v as f64).powi(2)).sqrt());
+            for ch in 0..3 {
+                let truth = central0.get(u, v, ch);
+                if let Some(s) = rs.sample_bilinear(x as f32, y as f32, ch) {
+                    moved += (s - truth).abs() as f64;
+                    unmoved += (rs.get(u, v, ch) - truth).abs() as f64;
+                    n += 1;
+                }
+            }
+        }
+    }
+    let (moved, unmoved) = (moved / n as f64, unmoved / n as f64);
+    eprintln!("max shift {shift:.2} px; colour error {moved:.4} following the motion, {unmoved:.4} ignoring it, over {n} samples");
+    assert!(n > 3 * (S - 8) * (S - 8) * 8 / 10, "most pixels are masked visible: {n}");
+    assert!(shift > 4.0, "the motion must move points visibly: {shift} px");
+    assert!(moved < 0.025, "colour error {moved} following the true motion");
+    assert!(unmoved > 2.0 * moved, "ignoring the motion must be worse: {unmoved} vs {moved}");
+    assert!(mask.iter().any(|&m| !m), "some points leave the view or get hidden under motion");
+}
+
+#[test]
+fn the_same_seed_gives_the_same_scene_and_another_seed_another() {
+    let desc = base_scene("vegetation").unwrap();
+    let run = |seed| generate(&desc, &GenerateOptions { size: Some([48, 40]), seed }, |_, _| {}).unwrap();
+    let (a, b, c) = (run(1), run(1), run(2));
+    assert_eq!(a.views, b.views);
+    assert_eq!(a.truth.depth, b.truth.depth);
+    assert_ne!(a.views[40], c.views[40]);
+    assert_eq!((a.views[0].width, a.views[0].height), (48, 40));
+}
+
+#[test]
+fn the_suite_spans_static_slow_and_fast_motions_of_the_intended_size() {
+    let size = 128;
+    let entries = suite(&GenerateOptions { size: Some([size, size]), seed: 0 }).unwrap();
+    assert_eq!(entries.len(), 33);
+    let scale = size as f64 / 512.0;
+    let mut used = [false; 6];
+    for e in &entries {
+        let target = match e.category {
+            "static" => 0.0,
+            "slow" => SLOW_PX * scale,
+            "fast" => FAST_PX * scale,
+            other => panic!("category {other}"),
+        };
+        assert!((e.max_shift_px - target).abs() <= 0.05 * target.max(1.0), "{}: {} px for {target}", e.name, e.max_shift_px);
+        let m = e.description.motion().unwrap();
+        for (i, x) in m.groups().iter().flat_map(|g| g.1.clone()).enumerate() {
+            used[i] |= x != 0.0;
+        }
+    }
+    assert!(used.iter().all(|&u| u), "every velocity dimension is exercised: {used:?}");
+}
+
+#[test]
+fn generate_refuses_bad_descriptions_and_existing_folders_cleanly() {
+    let dir = tempdir();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "name = \"x\"\n[[object]]\nshape = { kind = \"cone\" }\nposition = [0, 0, 1]\n").unwrap();
+    let out = dir.path().join("out");
+    let (ok, _, stderr) = rslf(&["generate", bad.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert!(!ok && stderr.contains("bad.toml") && stderr.contains("line 3"), "{stderr}");
+    assert_eq!(stderr.matches("panicked").count(), 0);
+    assert!(!out.exists());
+
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml");
+    std::fs::create_dir(&out).unwrap();
+    let (ok, _, stderr) = rslf(&["generate", scene, "--out", out.to_str().unwrap(), "--size", "16"]);
+    assert!(!ok && stderr.contains("already exists"), "{stderr}");
+    let (ok, stdout, stderr) = rslf(&["generate", scene, "--out", out.to_str().unwrap(), "--size", "24x16", "--force"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("81 views rendered"), "{stdout}");
+    let written = Scene::load(&out).unwrap();
+    assert_eq!((written.width(), written.height(), written.present_views().len()), (24, 16, 81));
+}
