@@ -3,8 +3,8 @@
 mod common;
 
 use common::{rslf, tempdir};
-use rslf::geometry::{Camera, ViewId, rs_project};
-use rslf::io::{GroundTruth, MotionRecord, Raster, Scene};
+use rslf::geometry::{Camera, rs_project};
+use rslf::io::{GroundTruth, MotionRecord, Scene};
 use rslf::synth::{FAST_PX, GenerateOptions, SLOW_PX, SceneDescription, base_scene, generate, suite};
 use std::path::Path;
 
@@ -18,25 +18,6 @@ fn small_scene(dir: &Path, name: &str, size: usize, motion: Option<&MotionRecord
     Scene::load(dir).unwrap()
 }
 
-fn warp_error(scene: &Scene, gt: &Raster, view: ViewId, sign: f64) -> f64 {
-    let central = scene.central();
-    let img = scene.view(view).unwrap();
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for y in 8..central.height - 8 {
-        for x in 8..central.width - 8 {
-            let d = sign * gt.get(x, y, 0) as f64;
-            let (xs, ys) = scene.grid.position_in_view(view, x as f64, y as f64, d);
-            for ch in 0..3 {
-                if let Some(s) = img.sample_bilinear(xs as f32, ys as f32, ch) {
-                    sum += (s - central.get(x, y, ch)).abs() as f64;
-                    n += 1;
-                }
-            }
-        }
-    }
-    sum / n as f64
-}
-
 #[test]
 fn a_static_scene_warps_onto_its_central_view_with_its_ground_truth_disparity() {
     let dir = tempdir();
@@ -44,7 +25,7 @@ fn a_static_scene_warps_onto_its_central_view_with_its_ground_truth_disparity() 
     let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
     let disparity = gt.disparity.unwrap();
     for view in scene.grid.corners() {
-        let (right, wrong) = (warp_error(&scene, &disparity, view, 1.0), warp_error(&scene, &disparity, view, -1.0));
+        let (right, wrong) = (common::warp_error(&scene, &disparity, view, 1.0, 8), common::warp_error(&scene, &disparity, view, -1.0, 8));
         eprintln!("view {view:?}: warp error {right:.4} (FORMAT sign), {wrong:.4} (opposite)");
         // What remains is resampling of fine textures and disoccluded pixels; it halves from 128 to 256 px.
         assert!(right < 0.025, "view {view:?}: warp error {right}");

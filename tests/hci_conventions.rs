@@ -4,7 +4,7 @@ mod common;
 
 use common::{hci, rslf};
 use rslf::geometry::{ViewGrid, ViewId};
-use rslf::io::{Raster, Scene, read_pfm};
+use rslf::io::{Scene, read_pfm};
 
 #[test]
 fn antinous_loads_81_views_of_512x512_without_a_camera() {
@@ -32,27 +32,6 @@ fn cotton_loads_33_views_with_its_central_row_corners_and_camera() {
     assert_eq!(scene.params.as_ref().unwrap().disparity_range, Some((-1.6, 1.5)));
 }
 
-/// Mean absolute difference between the central view and `view` warped to it with `sign * gt`
-/// disparity, over pixels that stay inside the view.
-fn warp_error(scene: &Scene, gt: &Raster, view: ViewId, sign: f64) -> f64 {
-    let central = scene.central();
-    let img = scene.view(view).unwrap();
-    let (mut sum, mut n) = (0.0f64, 0usize);
-    for y in 20..central.height - 20 {
-        for x in 20..central.width - 20 {
-            let d = sign * gt.get(x, y, 0) as f64;
-            let (xs, ys) = scene.grid.position_in_view(view, x as f64, y as f64, d);
-            for ch in 0..3 {
-                if let Some(s) = img.sample_bilinear(xs as f32, ys as f32, ch) {
-                    sum += (s - central.get(x, y, ch)).abs() as f64;
-                    n += 1;
-                }
-            }
-        }
-    }
-    sum / n as f64
-}
-
 #[test]
 fn the_disparity_sign_of_format_reproduces_antinous_central_view() {
     let dir = hci("antinous");
@@ -62,8 +41,8 @@ fn the_disparity_sign_of_format_reproduces_antinous_central_view() {
     let views = [(0, 0), (0, 8), (8, 0), (8, 8), (4, 0), (4, 8), (0, 4), (8, 4)];
     for (row, col) in views {
         let view = ViewId { row, col };
-        let right = warp_error(&scene, &gt, view, 1.0);
-        let wrong = warp_error(&scene, &gt, view, -1.0);
+        let right = common::warp_error(&scene, &gt, view, 1.0, 20);
+        let wrong = common::warp_error(&scene, &gt, view, -1.0, 20);
         assert!(right < 0.02, "view {view:?}: error {right} with FORMAT's sign");
         assert!(wrong > 3.0 * right, "view {view:?}: FORMAT's sign {right} vs opposite {wrong}");
     }

@@ -1,7 +1,8 @@
 //! Helpers shared by the end-to-end tests: where the HCI scenes are, and tiny scenes made here.
 #![allow(dead_code)]
 
-use rslf::io::{Raster, SceneParameters, view_file_name, write_png};
+use rslf::geometry::ViewId;
+use rslf::io::{Raster, Scene, SceneParameters, view_file_name, write_png};
 use std::path::{Path, PathBuf};
 
 /// A folder of the HCI benchmark scenes (`../shared/data/hci` beside the project, or
@@ -109,4 +110,26 @@ pub fn rslf_with_env(args: &[&str], env: &[(&str, &Path)]) -> (bool, String, Str
     }
     let out = cmd.output().unwrap();
     (out.status.success(), String::from_utf8_lossy(&out.stdout).into_owned(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// Mean absolute difference between the central view and `view` warped onto it with
+/// `sign * disparity` by FORMAT's rule, over pixels `border` away from the edges whose sample
+/// stays inside the view.
+pub fn warp_error(scene: &Scene, disparity: &Raster, view: ViewId, sign: f64, border: usize) -> f64 {
+    let central = scene.central();
+    let img = scene.view(view).unwrap();
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for y in border..central.height - border {
+        for x in border..central.width - border {
+            let d = sign * disparity.get(x, y, 0) as f64;
+            let (xs, ys) = scene.grid.position_in_view(view, x as f64, y as f64, d);
+            for ch in 0..central.channels {
+                if let Some(s) = img.sample_bilinear(xs as f32, ys as f32, ch) {
+                    sum += (s - central.get(x, y, ch)).abs() as f64;
+                    n += 1;
+                }
+            }
+        }
+    }
+    sum / n as f64
 }
