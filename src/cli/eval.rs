@@ -1,7 +1,7 @@
 //! `rslf eval --scene DIR --result DIR`.
 
 use crate::eval::evaluate;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `rslf eval`.
 #[derive(Debug, clap::Args)]
@@ -17,14 +17,20 @@ pub struct EvalArgs {
     pub no_write: bool,
 }
 
-/// Evaluates, prints the table, and writes `metrics.json` into the result folder.
-pub fn run(args: EvalArgs) -> crate::Result<()> {
-    let report = evaluate(&args.scene, &args.result)?;
+/// Evaluates `result` against `scene`, prints the table, and (when `write`) writes
+/// `metrics.json` into the result folder.
+pub fn report(scene: &Path, result: &Path, write: bool) -> crate::Result<()> {
+    let report = evaluate(scene, result)?;
     print!("{report}");
-    if !args.no_write {
-        let path = args.result.join("metrics.json");
+    if write {
+        let path = result.join("metrics.json");
         report.write_json(&path)?;
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// Runs `rslf eval`.
+pub fn run(args: EvalArgs) -> crate::Result<()> {
+    report(&args.scene, &args.result, !args.no_write)
 }

@@ -1,6 +1,6 @@
 //! `rslf generate SCENE.toml --out DIR` and `rslf generate --suite --out DIR`.
 
-use crate::synth::{GenerateOptions, SceneDescription, generate, suite};
+use crate::synth::{GenerateOptions, SceneDescription, generate_with_progress, suite};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -47,13 +47,7 @@ fn one(description: &SceneDescription, options: &GenerateOptions, out: &std::pat
         return Err(crate::io::IoError::new(out, "already exists (pass --force to replace it)").into());
     }
     let start = Instant::now();
-    let bar = crate::progress::bar(1, &description.name);
-    let scene = generate(description, options, |done, total| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-    })
-    .map_err(crate::Error::Usage)?;
-    bar.finish_and_clear();
+    let scene = generate_with_progress(description, options).map_err(crate::Error::Usage)?;
     let seconds = start.elapsed().as_secs_f64();
     scene.write(out, force)?;
     Ok(seconds)

@@ -1,7 +1,6 @@
 //! `rslf train CONFIG [--scene DIR] [--out DIR]`.
 
 use crate::config::Config;
-use crate::eval::evaluate;
 use crate::io::{GroundTruth, Scene};
 use crate::model::SavedModel;
 use crate::pipeline;
@@ -72,11 +71,7 @@ pub fn run(args: TrainArgs) -> crate::Result<()> {
         println!("wrote {}", path.display());
     }
     if !gt.is_empty() {
-        let report = evaluate(&scene_dir, &out)?;
-        print!("{report}");
-        let path = out.join("metrics.json");
-        report.write_json(&path)?;
-        println!("wrote {}", path.display());
+        super::eval::report(&scene_dir, &out, true)?;
     }
     Ok(())
 }

@@ -10,12 +10,8 @@ pub use metrics::{
 pub use report::{DepthReport, EvalReport, MotionReport};
 
 use crate::geometry::Camera;
-use crate::io::{GroundTruth, IoError, IoResult, MotionRecord, Raster, Scene, read_image, read_pfm};
+use crate::io::{GroundTruth, IoError, IoResult, MotionRecord, Raster, Scene, read_if_present, read_image, read_pfm};
 use std::path::Path;
-
-fn read_optional<T>(path: &Path, read: impl FnOnce(&Path) -> IoResult<T>) -> IoResult<Option<T>> {
-    if path.exists() { read(path).map(Some) } else { Ok(None) }
-}
 
 fn sized(path: &Path, r: Option<Raster>, w: usize, h: usize) -> IoResult<Option<Raster>> {
     match r {
@@ -43,10 +39,10 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
     let depth_path = result.join("depth.pfm");
     let central_path = result.join("central.png");
     let motion_path = result.join("motion.toml");
-    let est_disp = sized(&disp_path, read_optional(&disp_path, read_pfm)?, w, h)?;
-    let est_depth = sized(&depth_path, read_optional(&depth_path, read_pfm)?, w, h)?;
-    let est_central = sized(&central_path, read_optional(&central_path, read_image)?, w, h)?;
-    let est_motion = read_optional(&motion_path, MotionRecord::read)?;
+    let est_disp = sized(&disp_path, read_if_present(&disp_path, read_pfm)?, w, h)?;
+    let est_depth = sized(&depth_path, read_if_present(&depth_path, read_pfm)?, w, h)?;
+    let est_central = sized(&central_path, read_if_present(&central_path, read_image)?, w, h)?;
+    let est_motion = read_if_present(&motion_path, MotionRecord::read)?;
     if est_disp.is_none() && est_depth.is_none() && est_central.is_none() && est_motion.is_none() {
         return Err(IoError::new(result, "has none of disparity.pfm, depth.pfm, central.png, motion.toml"));
     }

@@ -23,7 +23,8 @@ pub struct GroundTruth {
     pub motion: Option<MotionRecord>,
 }
 
-fn optional<T>(path: &Path, read: impl FnOnce(&Path) -> IoResult<T>) -> IoResult<Option<T>> {
+/// Reads `path` with `read` when it exists; `None` when it does not.
+pub fn read_if_present<T>(path: &Path, read: impl FnOnce(&Path) -> IoResult<T>) -> IoResult<Option<T>> {
     if path.exists() { read(path).map(Some) } else { Ok(None) }
 }
 
@@ -39,7 +40,7 @@ impl GroundTruth {
     pub fn load(dir: &Path, width: usize, height: usize) -> IoResult<Self> {
         let map = |name: &str| -> IoResult<Option<Raster>> {
             let path = dir.join(name);
-            let r = optional(&path, read_pfm)?;
+            let r = read_if_present(&path, read_pfm)?;
             if let Some(r) = &r {
                 check_size(&path, r, width, height)?;
             }
@@ -47,7 +48,7 @@ impl GroundTruth {
         };
         let image = |name: &str| -> IoResult<Option<Raster>> {
             let path = dir.join(name);
-            let r = optional(&path, read_image)?;
+            let r = read_if_present(&path, read_image)?;
             if let Some(r) = &r {
                 check_size(&path, r, width, height)?;
             }
@@ -61,7 +62,7 @@ impl GroundTruth {
             depth: map("gt_depth_lowres.pfm")?,
             mask,
             central: image("gt_central.png")?,
-            motion: optional(&dir.join("gt_motion.toml"), MotionRecord::read)?,
+            motion: read_if_present(&dir.join("gt_motion.toml"), MotionRecord::read)?,
         })
     }
 

@@ -13,7 +13,7 @@ mod scene;
 
 pub use atomic::{create_dir_all, write_atomic};
 pub use error::{IoError, IoResult};
-pub use ground_truth::GroundTruth;
+pub use ground_truth::{GroundTruth, read_if_present};
 pub use image_file::{read_image, write_mask_png, write_png};
 pub use motion_file::MotionRecord;
 pub use params::SceneParameters;

@@ -183,35 +183,26 @@ pub fn fill_unconfident(map: &mut Raster, confident: &[bool]) {
     let (w, h) = (map.width, map.height);
     let mut sum = vec![0.0f64; w * h];
     let mut weight = vec![0.0f64; w * h];
-    let mut add = |i: usize, value: f32, dist: usize| {
-        let wt = 1.0 / dist as f64;
-        sum[i] += wt * value as f64;
-        weight[i] += wt;
-    };
-    // Each scan carries the last confident value and its position along a line.
-    for y in 0..h {
+    // One scan along a line of pixel indices, carrying the last confident value and its step.
+    let mut scan = |line: &mut dyn Iterator<Item = usize>| {
         let mut last: Option<(f32, usize)> = None;
-        for x in 0..w {
-            let i = y * w + x;
-            if confident[i] { last = Some((map.data[i], x)) } else if let Some((v, at)) = last { add(i, v, x - at) }
+        for (step, i) in line.enumerate() {
+            if confident[i] {
+                last = Some((map.data[i], step));
+            } else if let Some((value, at)) = last {
+                let wt = 1.0 / (step - at) as f64;
+                sum[i] += wt * value as f64;
+                weight[i] += wt;
+            }
         }
-        last = None;
-        for x in (0..w).rev() {
-            let i = y * w + x;
-            if confident[i] { last = Some((map.data[i], x)) } else if let Some((v, at)) = last { add(i, v, at - x) }
-        }
+    };
+    for y in 0..h {
+        scan(&mut (0..w).map(|x| y * w + x));
+        scan(&mut (0..w).rev().map(|x| y * w + x));
     }
     for x in 0..w {
-        let mut last: Option<(f32, usize)> = None;
-        for y in 0..h {
-            let i = y * w + x;
-            if confident[i] { last = Some((map.data[i], y)) } else if let Some((v, at)) = last { add(i, v, y - at) }
-        }
-        last = None;
-        for y in (0..h).rev() {
-            let i = y * w + x;
-            if confident[i] { last = Some((map.data[i], y)) } else if let Some((v, at)) = last { add(i, v, at - y) }
-        }
+        scan(&mut (0..h).map(|y| y * w + x));
+        scan(&mut (0..h).rev().map(|y| y * w + x));
     }
     for i in 0..w * h {
         if !confident[i] && weight[i] > 0.0 {

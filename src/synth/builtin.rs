@@ -1,7 +1,7 @@
 //! Built-in scenes by name (`scene = "builtin:checkerboards_slow1"` in a config): suite entries
 //! generated into a cache folder the first time they are asked for.
 
-use super::scene_folder::{GenerateOptions, generate};
+use super::scene_folder::{GenerateOptions, generate_with_progress};
 use super::suite::suite;
 use crate::io::{IoError, IoResult};
 use std::path::PathBuf;
@@ -36,13 +36,7 @@ pub fn builtin_scene(name: &str) -> IoResult<PathBuf> {
         IoError::new(format!("{BUILTIN_PREFIX}{name}"), format!("no such built-in scene (expected one of {})", names.join(", ")))
     })?;
     println!("generating built-in scene {name} into {} (once)", dir.display());
-    let bar = crate::progress::bar(81, "generating views");
-    let scene = generate(&entry.description, &options, |done, total| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
-    })
-    .map_err(|e| IoError::new(&dir, e))?;
-    bar.finish_and_clear();
+    let scene = generate_with_progress(&entry.description, &options).map_err(|e| IoError::new(&dir, e))?;
     scene.write(&dir, true)?;
     Ok(dir)
 }

@@ -15,7 +15,7 @@ mod world;
 pub use builtin::{BUILTIN_PREFIX, builtin_scene, cache_dir};
 pub use description::{CameraSettings, ObjectDescription, RenderSettings, SceneDescription};
 pub use render::Capture;
-pub use scene_folder::{GenerateOptions, GeneratedScene, capture_setup, generate};
+pub use scene_folder::{GenerateOptions, GeneratedScene, capture_setup, generate, generate_with_progress};
 pub use shapes::Shape;
 pub use suite::{BASE_SCENES, DIRECTIONS, FAST_PX, SLOW_PX, SuiteEntry, base_scene, max_shift_px, suite};
 pub use texture::{Rgb, Texture};

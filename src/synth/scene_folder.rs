@@ -72,6 +72,17 @@ pub fn generate(
     Ok(GeneratedScene { params, views, truth, motion })
 }
 
+/// [`generate`] with a progress bar on stderr (shown only on a terminal).
+pub fn generate_with_progress(desc: &SceneDescription, options: &GenerateOptions) -> Result<GeneratedScene, String> {
+    let bar = crate::progress::bar(1, &desc.name);
+    let scene = generate(desc, options, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    scene
+}
+
 impl GeneratedScene {
     /// Writes the scene folder `out`: views, `parameters.cfg`, ground truth. The folder appears
     /// only once complete; an existing `out` is replaced only when `replace` is set.
