@@ -16,6 +16,7 @@ pub mod error;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+pub mod loss;
 pub mod model;
 pub mod pipeline;
 pub mod progress;

@@ -134,6 +134,18 @@ fn config_with_a_wrong_type() {
 }
 
 #[test]
+fn config_naming_an_unknown_loss_or_motion_model() {
+    let root = common::tempdir();
+    let (scene, config) = valid_scene(root.path());
+    std::fs::write(&config, "[[loss]]\nkind = \"perceptual\"\n").unwrap();
+    assert_train_fails(&scene, &config, "run.toml", "unknown loss term `perceptual`");
+    std::fs::write(&config, "[motion]\nmodel = \"helical\"\n").unwrap();
+    assert_train_fails(&scene, &config, "run.toml", "motion model `helical`: unknown");
+    std::fs::write(&config, "[motion]\nmodel = \"piecewise_constant\"\nsegments = 0\n").unwrap();
+    assert_train_fails(&scene, &config, "run.toml", "motion.segments`: must be at least 1");
+}
+
+#[test]
 fn missing_config() {
     let root = common::tempdir();
     let (scene, _) = valid_scene(root.path());

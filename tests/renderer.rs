@@ -121,8 +121,8 @@ fn the_same_config_and_seed_give_the_same_stage_one_result_twice_on_flex() {
     )
     .unwrap();
     let device = rslf::device::device(config.device);
-    let (a, _) = rslf::pipeline::run(&config, &scene, &device);
-    let (b, _) = rslf::pipeline::run(&config, &scene, &device);
+    let (a, _) = rslf::pipeline::run(&config, &scene, &device).unwrap();
+    let (b, _) = rslf::pipeline::run(&config, &scene, &device).unwrap();
     assert_eq!(a.disparity, b.disparity);
     assert_eq!(a.central, b.central);
     assert_eq!(a.curves, b.curves);

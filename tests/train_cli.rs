@@ -19,7 +19,8 @@ fn train_recovers_the_disparity_of_a_plane_and_writes_a_format_result() {
     std::fs::write(&config, format!("scene = {:?}\n[stage1]\ndisparity_step = 0.1\n", scene.to_str().unwrap())).unwrap();
     let out = root.path().join("result");
 
-    let (ok, stdout, stderr) = rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let models = root.path().join("models");
+    let (ok, stdout, stderr) = rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap(), "--models", models.to_str().unwrap()]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("stage 1 initialisation"), "{stdout}");
 

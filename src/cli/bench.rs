@@ -102,7 +102,7 @@ pub fn run(args: BenchArgs) -> crate::Result<()> {
         config.stage1.gaussians = n;
         let device = crate::device::device(DeviceChoice::Flex);
         let start = Instant::now();
-        let (_, log) = crate::pipeline::run(&config, &loaded, &device);
+        let (_, log) = crate::pipeline::run(&config, &loaded, &device)?;
         println!("stage 1 on the generated `objects` scene ({s}x{s}, 81 views generated in {generated:.1} s), flex:");
         for line in log.lines {
             println!("  {line}");

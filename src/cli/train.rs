@@ -26,6 +26,8 @@ pub struct TrainArgs {
 /// when the scene has ground truth).
 pub fn run(args: TrainArgs) -> crate::Result<()> {
     let config = Config::read(&args.config)?;
+    let registries = pipeline::Registries::default();
+    registries.check(&config).map_err(|e| crate::Error::Usage(format!("{}: {e}", args.config.display())))?;
     let scene_dir = args.scene.or(config.scene.clone()).ok_or_else(|| {
         crate::Error::Usage(format!("{}: no scene: set `scene` in the config or pass --scene DIR", args.config.display()))
     })?;
@@ -54,7 +56,7 @@ pub fn run(args: TrainArgs) -> crate::Result<()> {
         }
     );
     let device = crate::device::device(config.device);
-    let (result, log) = pipeline::run(&config, &scene, &device);
+    let (result, log) = pipeline::run_with(&config, &scene, &device, &registries)?;
     for line in &log.lines {
         println!("{line}");
     }

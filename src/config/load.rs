@@ -167,7 +167,8 @@ mod tests {
         assert_eq!(c.scene.as_deref(), Some(Path::new("scenes/a")));
         assert_eq!(c.stage1.gaussians, 20_000);
         assert_eq!(c.motion.model, "constant_velocity");
-        assert_eq!(c.loss.len(), 1);
+        let kinds: Vec<&str> = c.loss.iter().map(|l| l.kind.as_str()).collect();
+        assert_eq!(kinds, vec!["l1", "smoothness"]);
     }
 
     #[test]

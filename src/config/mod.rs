@@ -4,4 +4,4 @@ mod load;
 mod schema;
 
 pub use load::ConfigError;
-pub use schema::{Config, DeviceChoice, LossConfig, MotionConfig, RenderConfig, Stage1Config, Stage2Config, ViewSelection};
+pub use schema::{Config, DeviceChoice, LossConfig, MotionConfig, RenderConfig, Stage1Config, Stage2Config, TimingChoice, ViewSelection};

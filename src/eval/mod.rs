@@ -1,13 +1,18 @@
 //! Evaluation of a result folder against a scene's ground truth (`rslf eval`).
 
 mod metrics;
+mod motion_error;
 mod report;
 
 pub use metrics::{
     BADPIX_THRESHOLDS, DepthMetrics, DisparityMetrics, HCI_BORDER_PX, ParameterError, depth_metrics, disparity_metrics,
     evaluation_region, motion_parameter_errors, psnr_db,
 };
+pub use motion_error::{ImageMotionError, image_motion_error};
 pub use report::{DepthReport, EvalReport, MotionReport};
+
+/// `rslf eval` compares motions on every 4th ground-truth pixel each way.
+pub const MOTION_POINT_STRIDE: usize = 4;
 
 use crate::geometry::Camera;
 use crate::io::{GroundTruth, IoError, IoResult, MotionRecord, Raster, Scene, read_if_present, read_image, read_pfm};
@@ -99,6 +104,10 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
             estimated_model: e.model_name().into(),
             true_model: t.model_name().into(),
             parameters: motion_parameter_errors(e, t),
+            image: match (&camera, &gt.depth) {
+                (Some(cam), Some(z)) => image_motion_error(cam, e, t, z, MOTION_POINT_STRIDE),
+                _ => None,
+            },
         }),
         (None, Some(_)) => {
             notes.push("no motion.toml in the result: motion not evaluated".into());

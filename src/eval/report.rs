@@ -1,6 +1,7 @@
 //! The evaluation report: what `rslf eval` prints and writes as `metrics.json`.
 
 use super::metrics::{DepthMetrics, DisparityMetrics, ParameterError};
+use super::motion_error::ImageMotionError;
 use crate::io::{IoError, IoResult, write_atomic};
 use serde::Serialize;
 use std::fmt;
@@ -27,6 +28,8 @@ pub struct MotionReport {
     pub true_model: String,
     /// Errors per parameter group, when both use the same model.
     pub parameters: Option<Vec<ParameterError>>,
+    /// The image-space error, when the scene has a camera and ground-truth depth.
+    pub image: Option<ImageMotionError>,
 }
 
 /// Everything `rslf eval` measured. Non-finite numbers are written as `null`.
@@ -80,6 +83,18 @@ impl fmt::Display for EvalReport {
             writeln!(f, "central    PSNR {} dB", num(p, 2))?;
         }
         if let Some(m) = &self.motion {
+            if let Some(i) = &m.image {
+                let views: Vec<String> = i.per_view_px.iter().map(|(v, e)| format!("{v}: {}", num(*e, 3))).collect();
+                writeln!(
+                    f,
+                    "motion     image-space RMS error {} px (true RS shift {} px, {:.1}% of it) over {} points; per view {}",
+                    num(i.rms_error_px, 3),
+                    num(i.rms_true_shift_px, 3),
+                    100.0 * i.rms_error_px / i.rms_true_shift_px,
+                    i.points,
+                    views.join(", ")
+                )?;
+            }
             match &m.parameters {
                 Some(groups) => {
                     for g in groups {

@@ -1,9 +1,14 @@
-//! Geometry of the light-field camera (FORMAT conventions), on the host.
+//! Geometry of the light-field camera (FORMAT conventions): host versions (nalgebra) for the
+//! generator, the evaluation and the checks, tensor versions (burn) for what is differentiated.
 
 mod camera;
+mod lift;
+mod rotation;
 mod rigid_motion;
 mod rs_projection;
 
 pub use camera::{Camera, ViewGrid, ViewId};
 pub use rigid_motion::{Pose, pose_at, readout_interval};
 pub use rs_projection::rs_project;
+pub use lift::TensorCamera;
+pub use rotation::{PoseBatch, rotate, rotate_inverse, rotation_matrices};

@@ -1,6 +1,8 @@
-//! Differentiable scene models (burn `Module`s) and their saved form.
+//! Differentiable scene models (burn `Module`s): the Gaussians, the motion models, and their
+//! saved form.
 
 mod gaussians;
+pub mod motion;
 mod saved;
 
 pub use gaussians::{GaussianSet, Gaussians};

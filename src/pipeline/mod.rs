@@ -5,18 +5,22 @@ mod gaussian_init;
 mod plane_sweep;
 mod results;
 mod stage1_fit;
+mod stage2_fit;
 
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
-pub use results::{RunResult, depth_map};
+pub use results::{PointCloud, RunResult, depth_map};
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor};
+pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales};
 
-use crate::config::Config;
-use crate::geometry::ViewId;
-use crate::io::{Raster, Scene};
+use crate::config::{Config, TimingChoice, ViewSelection};
+use crate::geometry::{Camera, TensorCamera, ViewId, readout_interval};
+use crate::io::{MotionRecord, Raster, Scene};
+use crate::loss::{LossRegistry, WeightedLosses};
 use crate::model::Gaussians;
-use crate::render::{RenderSettings, render_rows};
-use burn::tensor::Device;
+use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
+use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, splat};
+use burn::tensor::{Device, Tensor, TensorData};
 use std::time::Instant;
 
 /// Opacity above which a rendered pixel's blended disparity is trusted over the initial map.
@@ -57,12 +61,48 @@ pub fn stage1_views(scene: &Scene, count: usize) -> Vec<ViewId> {
     row
 }
 
-/// Renders the central view of `g`: its colour, and its disparity where opaque enough
-/// (elsewhere `fallback`'s).
-pub fn render_central(g: &Gaussians, scene: &Scene, settings: &RenderSettings, fallback: &Raster, device: &Device) -> (Raster, Raster) {
-    let (w, h, c) = (scene.width(), scene.height(), scene.channels());
-    let out = render_rows(g, (0.0, 0.0), w, 0..h, settings, device);
-    let data = |t: burn::tensor::TensorData| t.convert::<f32>().try_to_vec::<f32>().expect("float data");
+/// The registries a run draws its loss terms and motion models from. The defaults hold the
+/// built-in ones; add to them to run a config that names terms or models of your own.
+#[derive(Clone, Default)]
+pub struct Registries {
+    /// Loss terms by name.
+    pub losses: LossRegistry,
+    /// Motion models by name.
+    pub motions: MotionRegistry,
+}
+
+impl Registries {
+    /// Checks that every loss term and the motion model a config names exist and accept their
+    /// settings, so that a run fails at once rather than after stage 1.
+    pub fn check(&self, config: &Config) -> Result<(), String> {
+        self.losses.build(&config.loss).map_err(|e| e.to_string())?;
+        self.motions.build(&config.motion, &MotionSetup { readout: (-1.0, 1.0) }).map_err(|e| e.to_string())?;
+        Ok(())
+    }
+}
+
+/// The views stage 2 compares against: the four corners or every present view off the
+/// central row.
+pub fn stage2_views(scene: &Scene, selection: ViewSelection) -> Vec<ViewId> {
+    let centre_row = scene.central_id().row;
+    match selection {
+        ViewSelection::Corners => scene.grid.corners().into_iter().filter(|&v| scene.view(v).is_some()).collect(),
+        ViewSelection::AllOffRow => scene.present_views().into_iter().filter(|v| v.row != centre_row).collect(),
+    }
+}
+
+/// The read-out timing a config asks for.
+pub fn rs_timing(config: &Config) -> RsTiming {
+    match config.stage2.timing {
+        TimingChoice::Bands => RsTiming::Bands(config.stage2.band_height),
+        TimingChoice::PerGaussian => RsTiming::PerGaussian(config.stage2.timing_iterations),
+    }
+}
+
+/// Colour and opacity-normalised disparity of a whole-image render; the disparity is
+/// `fallback`'s where the render is not opaque enough.
+fn central_rasters(out: RenderOutput, w: usize, h: usize, c: usize, fallback: &Raster) -> (Raster, Raster) {
+    let data = |t: TensorData| t.convert::<f32>().try_to_vec::<f32>().expect("float data");
     let colour = data(out.colour.into_data());
     let disparity = data(out.disparity.into_data());
     let alpha = data(out.alpha.into_data());
@@ -72,9 +112,116 @@ pub fn render_central(g: &Gaussians, scene: &Scene, settings: &RenderSettings, f
     (Raster { width: w, height: h, channels: c, data: colour }, Raster { width: w, height: h, channels: 1, data: disparity })
 }
 
-/// Runs the pipeline on `scene` with `config` on `device`.
-pub fn run(config: &Config, scene: &Scene, device: &Device) -> (RunResult, RunLog) {
+/// Renders the central view of `g`: its colour, and its disparity where opaque enough
+/// (elsewhere `fallback`'s).
+pub fn render_central(g: &Gaussians, scene: &Scene, settings: &RenderSettings, fallback: &Raster, device: &Device) -> (Raster, Raster) {
+    let (w, h, c) = (scene.width(), scene.height(), scene.channels());
+    central_rasters(render_rows(g, (0.0, 0.0), w, 0..h, settings, device), w, h, c, fallback)
+}
+
+/// The scene at t = 0 under a motion: the Gaussians moved back from their rows' times.
+pub fn static_shape(g: &Gaussians, camera: &Camera, model: &dyn MotionModel, params: &[f64], device: &Device) -> StaticShape {
+    let p: Vec<f32> = params.iter().map(|&x| x as f32).collect();
+    let n = p.len();
+    StaticShape::new(g, TensorCamera::new(camera), model, Tensor::from_data(TensorData::new(p, [n]), device))
+}
+
+/// Renders the central view at t = 0 of the static shape of `g` under `model` at `params`:
+/// the rolling-shutter-compensated colour and disparity.
+#[allow(clippy::too_many_arguments)]
+pub fn render_compensated_central(
+    g: &Gaussians,
+    scene: &Scene,
+    camera: &Camera,
+    model: &dyn MotionModel,
+    params: &[f64],
+    settings: &RenderSettings,
+    fallback: &Raster,
+    device: &Device,
+) -> (Raster, Raster, StaticShape) {
+    let (w, h, c) = (scene.width(), scene.height(), scene.channels());
+    let shape = static_shape(g, camera, model, params, device);
+    let tensor_params = Tensor::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), device);
+    let splats = shape.splats_at_time(model, tensor_params, (0.0, 0.0), 0.0);
+    let out = splat(&splats, &splats.bins(w, 0..h, settings), device);
+    let (colour, disparity) = central_rasters(out, w, h, c, fallback);
+    (colour, disparity, shape)
+}
+
+/// Runs the pipeline on `scene` with `config` on `device`, with the built-in loss terms and
+/// motion models.
+pub fn run(config: &Config, scene: &Scene, device: &Device) -> crate::Result<(RunResult, RunLog)> {
+    run_with(config, scene, device, &Registries::default())
+}
+
+/// Runs the pipeline with loss terms and motion models drawn from `registries`.
+pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Registries) -> crate::Result<(RunResult, RunLog)> {
+    let usage = |e: &dyn std::fmt::Display| crate::Error::Usage(format!("config: {e}"));
+    let losses = registries.losses.build(&config.loss).map_err(|e| usage(&e))?;
+    let camera = scene.camera();
+    let motion_model = match &camera {
+        Some(cam) => {
+            let setup = MotionSetup { readout: readout_interval(cam.height, cam.line_time_s) };
+            Some(registries.motions.build(&config.motion, &setup).map_err(|e| usage(&e))?)
+        }
+        None => None,
+    };
     let mut log = RunLog::default();
+    let (gaussians, initial, mut curves) = stage1(config, scene, &losses, device, &mut log);
+    let render = render_settings(config);
+
+    let initial_motion = match &config.stage2.initial_motion {
+        Some(path) => Some(MotionRecord::read(path)?),
+        None => None,
+    };
+    let stage2_ready = scene.is_rolling_shutter() && (config.stage2.iterations > 0 || initial_motion.is_some());
+    let (central, disparity, motion, points, gaussians) = match (stage2_ready, &camera, &motion_model) {
+        (true, Some(cam), Some(model)) => {
+            let start = match &initial_motion {
+                Some(record) => model.parameters_of(record).ok_or_else(|| {
+                    crate::Error::Usage(format!(
+                        "config: stage2.initial_motion is a `{}` motion, which the `{}` model cannot express",
+                        record.model_name(),
+                        model.name()
+                    ))
+                })?,
+                None => vec![0.0; model.parameters().len()],
+            };
+            let fitted = stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &losses, device, &mut log);
+            let gaussians = fitted.gaussians.clone();
+            let (central, disparity, shape) =
+                render_compensated_central(&gaussians, scene, cam, model.as_ref(), &fitted.parameters, &render, &initial, device);
+            curves.push(("stage2".to_string(), fitted.curve));
+            (central, disparity, Some(model.record(&fitted.parameters)), Some(PointCloud::of_shape(&shape)), gaussians)
+        }
+        _ => {
+            if scene.is_rolling_shutter() {
+                log.lines.push("stage 2 (motion): skipped, stage2.iterations = 0; the result is not compensated".into());
+            } else if camera.is_none() {
+                log.lines.push("stage 2 (motion): skipped, no parameters.cfg (no camera, so no motion or depth)".into());
+            } else {
+                log.lines.push("stage 2 (motion): skipped, global-shutter scene (no [rolling_shutter] in parameters.cfg)".into());
+            }
+            let (central, disparity) = render_central(&gaussians, scene, &render, &initial, device);
+            // With no motion the Gaussians are already the scene at t = 0.
+            let points = match (&camera, &motion_model) {
+                (Some(cam), Some(model)) => {
+                    let zero = vec![0.0; model.parameters().len()];
+                    Some(PointCloud::of_shape(&static_shape(&gaussians, cam, model.as_ref(), &zero, device)))
+                }
+                _ => None,
+            };
+            // FORMAT: no motion.toml for a global-shutter scene, nor when none was estimated.
+            (central, disparity, None, points, gaussians)
+        }
+    };
+    let result = RunResult { disparity, central, motion, gaussians: Some(gaussians.to_set()), points, curves };
+    Ok((result, log))
+}
+
+/// Stage 1: plane sweep, sampling and fit. Returns the Gaussians, the initial disparity map
+/// (the fallback where the render is transparent) and the loss curve.
+fn stage1(config: &Config, scene: &Scene, losses: &WeightedLosses, device: &Device, log: &mut RunLog) -> (Gaussians, Raster, Vec<(String, Vec<f32>)>) {
     let settings = sweep_settings(config, scene);
     let row_views = scene.central_row_views();
     let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
@@ -96,7 +243,6 @@ pub fn run(config: &Config, scene: &Scene, device: &Device) -> (RunResult, RunLo
     let mut gaussians = set.to_module(device);
     log.lines.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
 
-    let render = render_settings(config);
     let views = stage1_views(scene, config.stage1.views);
     let mut curves = Vec::new();
     if config.stage1.iterations > 0 {
@@ -106,31 +252,82 @@ pub fn run(config: &Config, scene: &Scene, device: &Device) -> (RunResult, RunLo
             band_height: s.band_height,
             adam_epsilon: s.adam_epsilon as f32,
             lr: LearningRates { position: s.lr_position, disparity: s.lr_disparity, size: s.lr_size, colour: s.lr_colour },
-            render,
+            render: render_settings(config),
         };
         let bar = crate::progress::bar(s.iterations as u64, "stage 1: fit");
         let start = Instant::now();
-        let (fitted, curve) = fit_stage1(gaussians, scene, &views, &fit, device, |done, _, loss| {
+        let (fitted, curve) = fit_stage1(gaussians, scene, &views, &fit, losses, device, |done, _, loss| {
             bar.set_position(done as u64);
-            bar.set_message(format!("stage 1: L1 {loss:.4}"));
+            bar.set_message(format!("stage 1: loss {loss:.4}"));
         });
         bar.finish_and_clear();
         gaussians = fitted;
         log.lines.push(format!(
-            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row views, L1 {:.4} -> {:.4}, {:.1} s",
+            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row views, loss ({}) {:.4} -> {:.4}, {:.1} s",
             s.iterations,
             s.band_height,
             views.len(),
+            losses.names().join(" + "),
             curve.first().copied().unwrap_or(f32::NAN),
             curve.last().copied().unwrap_or(f32::NAN),
             start.elapsed().as_secs_f64()
         ));
         curves.push(("stage1".to_string(), curve));
     }
-    if scene.is_rolling_shutter() && config.stage2.iterations > 0 {
-        log.lines.push("stage 2 (motion): not part of this version yet; no motion.toml written".into());
-    }
-    let (central, disparity) = render_central(&gaussians, scene, &render, &estimate.disparity, device);
-    let result = RunResult { disparity, central, motion: None, gaussians: Some(gaussians.to_set()), curves };
-    (result, log)
+    (gaussians, estimate.disparity, curves)
+}
+
+/// Stage 2: the motion, fitted against the off-row views.
+#[allow(clippy::too_many_arguments)]
+fn stage2(
+    config: &Config,
+    scene: &Scene,
+    camera: &Camera,
+    model: &dyn MotionModel,
+    gaussians: Gaussians,
+    start_values: &[f64],
+    losses: &WeightedLosses,
+    device: &Device,
+    log: &mut RunLog,
+) -> MotionFit {
+    let s = &config.stage2;
+    let mut views = stage2_views(scene, s.views);
+    let refine = (s.refine_gaussians > 0.0).then(|| {
+        let (k, s1) = (s.refine_gaussians, &config.stage1);
+        views.extend(stage1_views(scene, s1.views));
+        let lr = LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
+        (lr, s1.adam_epsilon as f32)
+    });
+    let fit = Stage2Fit {
+        iterations: s.iterations,
+        timing: rs_timing(config),
+        band_height: s.band_height,
+        bands_per_step: s.bands_per_step,
+        lr: s.lr,
+        lr_final: s.lr_final,
+        adam_epsilon: s.adam_epsilon as f32,
+        seed: config.seed,
+        render: render_settings(config),
+        refine,
+    };
+    let bar = crate::progress::bar(s.iterations as u64, "stage 2: motion");
+    let start = Instant::now();
+    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, |done, _, loss| {
+        bar.set_position(done as u64);
+        bar.set_message(format!("stage 2: loss {loss:.4}"));
+    });
+    bar.finish_and_clear();
+    log.lines.push(format!(
+        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), loss {:.4} -> {:.4}, {:.1} s",
+        model.name(),
+        s.iterations,
+        s.bands_per_step,
+        s.band_height,
+        views.len(),
+        s.timing,
+        fitted.curve.first().copied().unwrap_or(f32::NAN),
+        fitted.curve.last().copied().unwrap_or(f32::NAN),
+        start.elapsed().as_secs_f64()
+    ));
+    fitted
 }

@@ -3,6 +3,7 @@
 
 use crate::geometry::ViewId;
 use crate::io::{Raster, Scene};
+use crate::loss::{LossInput, WeightedLosses};
 use crate::model::Gaussians;
 use crate::render::{RenderSettings, bins_for_view, render};
 use burn::module::ParamGroup;
@@ -53,7 +54,7 @@ fn band_tensor(img: &Raster, rows: std::ops::Range<usize>, device: &Device) -> T
 }
 
 /// The per-group learning-rate policy of `g`.
-fn lr_policy(g: &Gaussians, lr: &LearningRates) -> ModuleLrScheduler {
+pub(crate) fn lr_policy(g: &Gaussians, lr: &LearningRates) -> ModuleLrScheduler {
     let group = |id| ParamGroup::from_ids(vec![id]);
     ModuleLrSchedulerConfig::new(LrSchedulerConfig::Constant(lr.position))
         .with_group(group(g.centre.id), LrSchedulerConfig::Constant(lr.position))
@@ -64,7 +65,8 @@ fn lr_policy(g: &Gaussians, lr: &LearningRates) -> ModuleLrScheduler {
         .expect("constant schedules are valid")
 }
 
-/// Fits `g` to `views` of `scene`; returns the fitted Gaussians and the L1 loss of each step.
+/// Fits `g` to `views` of `scene` under `losses`; returns the fitted Gaussians and the loss of
+/// each step.
 /// Each step renders the same band of rows in every view (the views of the central row see a
 /// point on the same row), so that every step weighs all the disparity cues; bands are taken
 /// in turn. `progress(step, total, loss)` is called after each step.
@@ -73,6 +75,7 @@ pub fn fit_stage1(
     scene: &Scene,
     views: &[ViewId],
     fit: &Stage1Fit,
+    losses: &WeightedLosses,
     device: &Device,
     mut progress: impl FnMut(usize, usize, f32),
 ) -> (Gaussians, Vec<f32>) {
@@ -102,13 +105,15 @@ pub fn fit_stage1(
         for ((offset, _), target) in targets.iter().zip(&band_targets[b]) {
             let bins = bins_for_view(&set, *offset, w, bands[b].clone(), &fit.render);
             let out = render(&g, *offset, &bins, device);
-            let term = (out.colour - target.clone()).abs().mean();
+            let input = LossInput { rendered: &out, target, rows: bands[b].len(), width: w, motion: None };
+            let Some(term) = losses.evaluate(&input) else { continue };
             loss = Some(match loss {
                 Some(l) => l + term,
                 None => term,
             });
         }
-        let loss = loss.expect("at least one view") / targets.len() as f32;
+        let Some(loss) = loss else { break };
+        let loss = loss / targets.len() as f32;
         let value = loss.clone().into_scalar::<f32>();
         let grads = GradientsParams::from_grads(loss.backward(), &g);
         g = optim.step(schedule.step(), g, grads);

@@ -1,7 +1,10 @@
-//! The light-field Gaussian renderer: any view, any band of rows, colour, disparity and opacity.
+//! The light-field Gaussian renderer: any view, any band of rows, colour, disparity and opacity;
+//! with a rolling-shutter motion, the views as the moving sensor read them.
 
 mod binning;
+mod rolling_shutter;
 mod splat;
 
 pub use binning::{PixelBins, bin};
-pub use splat::{ALPHA_MAX, RenderOutput, RenderSettings, bins_for_view, render, render_rows};
+pub use splat::{ALPHA_MAX, RenderOutput, RenderSettings, bins_for_view, Splats, render, render_rows, splat};
+pub use rolling_shutter::{RsTiming, StaticShape, bands, concat_outputs, render_rolling_shutter};

@@ -40,16 +40,57 @@ pub struct RenderOutput {
     pub alpha: Tensor<1>,
 }
 
-/// The bins of `rows` of the view at `offset = (c - cc, r - rc)` for the current Gaussians.
+/// Gaussians as one view sees them: image-space centres, disparity (depth order), size and
+/// colour, all tensors so that whatever produced them (a disparity shift, a rigid motion and a
+/// projection) stays differentiable.
+#[derive(Debug, Clone)]
+pub struct Splats {
+    /// Centre column in the view, pixels: `[N]`.
+    pub u: Tensor<1>,
+    /// Centre row in the view, pixels: `[N]`.
+    pub v: Tensor<1>,
+    /// Disparity in the view (larger = nearer, blended first): `[N]`.
+    pub disparity: Tensor<1>,
+    /// Standard deviation, pixels: `[N]`.
+    pub sigma: Tensor<1>,
+    /// Colour: `[N, C]`.
+    pub colour: Tensor<2>,
+}
+
+impl Splats {
+    /// The Gaussians `g` in the view at `offset = (c - cc, r - rc)`: every centre moved by its
+    /// disparity, `(u - (c-cc) d, v - (r-rc) d)` (FORMAT's rule).
+    pub fn of_view(g: &Gaussians, offset: (f32, f32)) -> Self {
+        let n = g.len();
+        let centre = g.centre.val();
+        let d = g.disparity.val();
+        Self {
+            u: centre.clone().slice([0..n, 0..1]).reshape([n]) - d.clone() * offset.0,
+            v: centre.slice([0..n, 1..2]).reshape([n]) - d.clone() * offset.1,
+            disparity: d,
+            sigma: g.log_size.val().exp(),
+            colour: g.colour.val(),
+        }
+    }
+
+    /// The bins of `rows` of a `width`-pixel-wide view for these splats (read back to the host).
+    pub fn bins(&self, width: usize, rows: Range<usize>, settings: &RenderSettings) -> PixelBins {
+        let host = |t: &Tensor<1>| t.clone().into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
+        bin(&host(&self.u), &host(&self.v), &host(&self.disparity), &host(&self.sigma), width, rows, settings.max_per_pixel, settings.cutoff_sigma)
+    }
+}
+
+/// The bins of `rows` of the view at `offset = (c - cc, r - rc)` for the current Gaussians
+/// (host arithmetic, no tensor round trip).
 pub fn bins_for_view(set: &GaussianSet, offset: (f32, f32), width: usize, rows: Range<usize>, settings: &RenderSettings) -> PixelBins {
     let u: Vec<f32> = set.u.iter().zip(&set.disparity).map(|(u, d)| u - offset.0 * d).collect();
     let v: Vec<f32> = set.v.iter().zip(&set.disparity).map(|(v, d)| v - offset.1 * d).collect();
     bin(&u, &v, &set.disparity, &set.size, width, rows, settings.max_per_pixel, settings.cutoff_sigma)
 }
 
-/// Renders the band of `bins` of the view at `offset = (c - cc, r - rc)`.
-pub fn render(g: &Gaussians, offset: (f32, f32), bins: &PixelBins, device: &Device) -> RenderOutput {
-    let (p, k, n, c) = (bins.pixels(), bins.k, g.len(), g.channels());
+/// Blends `splats` over the pixels of `bins`, front to back.
+pub fn splat(s: &Splats, bins: &PixelBins, device: &Device) -> RenderOutput {
+    let (p, k, c) = (bins.pixels(), bins.k, s.colour.dims()[1]);
     let index = Tensor::<1, Int>::from_data(TensorData::new(bins.indices.clone(), [p * k]), device);
     let valid = Tensor::<2>::from_data(TensorData::new(bins.valid.clone(), [p, k]), device);
     let (xs, ys): (Vec<f32>, Vec<f32>) =
@@ -57,14 +98,9 @@ pub fn render(g: &Gaussians, offset: (f32, f32), bins: &PixelBins, device: &Devi
     let px = Tensor::<2>::from_data(TensorData::new(xs, [p, 1]), device);
     let py = Tensor::<2>::from_data(TensorData::new(ys, [p, 1]), device);
 
-    let centre = g.centre.val();
-    let d = g.disparity.val();
-    let u = centre.clone().slice([0..n, 0..1]).reshape([n]) - d.clone() * offset.0;
-    let v = centre.slice([0..n, 1..2]).reshape([n]) - d.clone() * offset.1;
-    let sigma = g.log_size.val().exp();
-    let gather = |t: Tensor<1>| t.select(0, index.clone()).reshape([p, k]);
-    let (ug, vg, dg, sg) = (gather(u), gather(v), gather(d), gather(sigma));
-    let cg = g.colour.val().select(0, index).reshape([p, k, c]);
+    let gather = |t: &Tensor<1>| t.clone().select(0, index.clone()).reshape([p, k]);
+    let (ug, vg, dg, sg) = (gather(&s.u), gather(&s.v), gather(&s.disparity), gather(&s.sigma));
+    let cg = s.colour.clone().select(0, index).reshape([p, k, c]);
 
     let dx = px - ug;
     let dy = py - vg;
@@ -77,6 +113,11 @@ pub fn render(g: &Gaussians, offset: (f32, f32), bins: &PixelBins, device: &Devi
     let disparity = (w.clone() * dg).sum_dim(1).reshape([p]);
     let alpha = w.sum_dim(1).reshape([p]);
     RenderOutput { colour, disparity, alpha }
+}
+
+/// Renders the band of `bins` of the view at `offset = (c - cc, r - rc)`.
+pub fn render(g: &Gaussians, offset: (f32, f32), bins: &PixelBins, device: &Device) -> RenderOutput {
+    splat(&Splats::of_view(g, offset), bins, device)
 }
 
 /// Bins and renders `rows` of the view at `offset` in one call.

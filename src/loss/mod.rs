@@ -1,0 +1,57 @@
+//! Loss terms: one trait, one file per term, and a registry that maps the names a config lists
+//! (`[[loss]] kind = "l1"`) to constructors. A new term is a new file plus one `register` line
+//! (or, outside the crate, one `LossRegistry::register` call: see `examples/custom_loss.rs`).
+//!
+//! Every term sees one rendered band of rows of one view ([`LossInput`]); a stage averages the
+//! weighted sum of the terms over the bands and views of a step.
+
+mod dssim;
+mod l1;
+mod l2;
+mod motion_prior;
+mod registry;
+mod smoothness;
+#[cfg(test)]
+mod tests;
+
+pub use dssim::DSsim;
+pub use l1::L1;
+pub use l2::L2;
+pub use motion_prior::MotionPrior;
+pub use registry::{LossRegistry, UnknownLoss, WeightedLoss, WeightedLosses};
+pub use smoothness::EdgeAwareSmoothness;
+
+use crate::render::RenderOutput;
+use burn::tensor::Tensor;
+
+/// What a loss term may look at: one band of `rows x width` pixels of one view.
+#[derive(Debug, Clone)]
+pub struct LossInput<'a> {
+    /// The render of the band.
+    pub rendered: &'a RenderOutput,
+    /// The observed pixels of the band, `[P, C]`, row-major.
+    pub target: &'a Tensor<2>,
+    /// Rows in the band.
+    pub rows: usize,
+    /// Pixels per row.
+    pub width: usize,
+    /// The motion parameters being fitted, scaled so that one unit moves the image by about one
+    /// pixel over the read-out (`None` in stages without motion).
+    pub motion: Option<&'a Tensor<1>>,
+}
+
+/// One term of the objective.
+pub trait LossTerm: Send + Sync {
+    /// The registry name (`l1`, `smoothness`, ...).
+    fn name(&self) -> &str;
+
+    /// The term's value for one band (a one-element tensor), or `None` when it does not apply
+    /// (e.g. a motion prior in a stage without motion).
+    fn evaluate(&self, input: &LossInput) -> Option<Tensor<1>>;
+}
+
+/// `[P, C]` band pixels as `[1, C, rows, width]` images, for window operations.
+pub(crate) fn as_image(t: Tensor<2>, rows: usize, width: usize) -> Tensor<4> {
+    let c = t.dims()[1];
+    t.reshape([rows, width, c]).permute([2, 0, 1]).unsqueeze::<4>()
+}

@@ -1,0 +1,174 @@
+//! Stage-2 fit: the motion parameters, by Adam, against views off the central row. Each step
+//! lifts the Gaussians, moves them back to t = 0 under the current motion, re-images them with
+//! rolling shutter into each view and compares a stratified sample of row bands.
+
+use crate::geometry::{Camera, TensorCamera, ViewId};
+use crate::io::{Raster, Scene};
+use crate::loss::{LossInput, WeightedLosses};
+use super::stage1_fit::{LearningRates, lr_policy};
+use crate::model::Gaussians;
+use crate::model::motion::{MotionModel, MotionParams, ScaleContext, parameter_scales};
+use crate::random::Rng;
+use crate::render::{RenderSettings, RsTiming, StaticShape, bands, splat};
+use burn::module::Module;
+use burn::optim::{AdamConfig, GradientsParams};
+use burn::tensor::{Device, Tensor, TensorData};
+
+/// Settings of the stage-2 fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stage2Fit {
+    /// Adam steps.
+    pub iterations: usize,
+    /// Read-out timing of the rendered views.
+    pub timing: RsTiming,
+    /// Rows per compared band (and per read-out time with [`RsTiming::Bands`]).
+    pub band_height: usize,
+    /// Bands compared per view and step, spread over the image.
+    pub bands_per_step: usize,
+    /// Starting learning rate, in scaled units (≈ pixels of image motion) per step; it decays
+    /// along a half cosine to `lr_final`.
+    pub lr: f64,
+    /// Final learning rate.
+    pub lr_final: f64,
+    /// Adam's epsilon.
+    pub adam_epsilon: f32,
+    /// Seed of the band sampling.
+    pub seed: u64,
+    /// Renderer settings.
+    pub render: RenderSettings,
+    /// Joint refinement: when set, the Gaussians are fitted too, at these rates (Adam's epsilon
+    /// as in stage 1), against the same views.
+    pub refine: Option<(LearningRates, f32)>,
+}
+
+/// What the fit found.
+#[derive(Debug, Clone)]
+pub struct MotionFit {
+    /// The parameter vector, SI units.
+    pub parameters: Vec<f64>,
+    /// The scale of each parameter (its change that moves the image by about one pixel).
+    pub scales: Vec<f64>,
+    /// Loss per step.
+    pub curve: Vec<f32>,
+    /// The Gaussians: refined with joint refinement, else as given.
+    pub gaussians: Gaussians,
+}
+
+/// The scales of `model`'s parameters for a scene: one unit moves a point at the Gaussians'
+/// median depth by about one pixel over half the read-out.
+pub fn motion_scales(model: &dyn MotionModel, g: &Gaussians, camera: &Camera) -> Vec<f64> {
+    let mut depths: Vec<f64> = g
+        .to_set()
+        .disparity
+        .iter()
+        .map(|&d| camera.disparity_to_depth(d as f64))
+        .filter(|z| z.is_finite() && *z > 0.0)
+        .collect();
+    depths.sort_by(f64::total_cmp);
+    let median = depths.get(depths.len() / 2).copied().unwrap_or(camera.focus_m);
+    let ctx = ScaleContext {
+        f_px: camera.f_px,
+        half_diagonal_px: 0.5 * ((camera.width * camera.width + camera.height * camera.height) as f64).sqrt(),
+        depth_m: median,
+        half_readout_s: (camera.height as f64 - 1.0) / 2.0 * camera.line_time_s,
+    };
+    parameter_scales(&model.parameters(), &ctx)
+}
+
+/// `count` band indices out of `total`, one from each of `count` equal strata.
+fn stratified(total: usize, count: usize, rng: &mut Rng) -> Vec<usize> {
+    let count = count.clamp(1, total);
+    (0..count)
+        .map(|k| {
+            let (lo, hi) = (k * total / count, ((k + 1) * total / count).max(k * total / count + 1));
+            lo + (rng.next_u64() % (hi - lo) as u64) as usize
+        })
+        .collect()
+}
+
+/// Rows `rows` of a view as a `[P, C]` tensor.
+fn rows_tensor(img: &Raster, rows: std::ops::Range<usize>, device: &Device) -> Tensor<2> {
+    let (w, c) = (img.width, img.channels);
+    let data = img.data[rows.start * w * c..rows.end * w * c].to_vec();
+    Tensor::from_data(TensorData::new(data, [rows.len() * w, c]), device)
+}
+
+/// Fits `model`'s parameters, starting from `start` (SI), to `views` of `scene`; the Gaussians
+/// `g` are held fixed unless `fit.refine` is set. `progress(step, total, loss)` is called after
+/// each step.
+#[allow(clippy::too_many_arguments)]
+pub fn fit_stage2(
+    g: Gaussians,
+    scene: &Scene,
+    camera: &Camera,
+    views: &[ViewId],
+    model: &dyn MotionModel,
+    start: &[f64],
+    fit: &Stage2Fit,
+    losses: &WeightedLosses,
+    device: &Device,
+    mut progress: impl FnMut(usize, usize, f32),
+) -> MotionFit {
+    let mut g = if fit.refine.is_some() { g } else { g.no_grad() };
+    let mut refine = fit.refine.map(|(lr, eps)| (AdamConfig::new().with_epsilon(eps).init(), lr_policy(&g, &lr)));
+    let tc = TensorCamera::new(camera);
+    let scales = motion_scales(model, &g, camera);
+    let mut motion = MotionParams::new(start, &scales, device);
+    let w = scene.width();
+    let all_bands = bands(0..scene.height(), RsTiming::Bands(fit.band_height), &tc);
+    let targets: Vec<((f32, f32), &Raster)> = views
+        .iter()
+        .filter_map(|&v| {
+            let (dx, dy) = scene.grid.offset(v);
+            Some(((dx as f32, dy as f32), scene.view(v)?))
+        })
+        .collect();
+    let mut optim = AdamConfig::new().with_epsilon(fit.adam_epsilon).init();
+    let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
+    let mut curve = Vec::with_capacity(fit.iterations);
+    for step in 0..fit.iterations {
+        let params = motion.si(&scales);
+        let shape = StaticShape::new(&g, tc, model, params.clone());
+        let scaled = motion.scaled.val();
+        let mut total: Option<Tensor<1>> = None;
+        let mut terms = 0usize;
+        for (offset, image) in &targets {
+            let rolling = match fit.timing {
+                RsTiming::PerGaussian(iterations) => Some(shape.splats_rolling(model, params.clone(), *offset, iterations)),
+                RsTiming::Bands(_) => None,
+            };
+            for b in stratified(all_bands.len(), fit.bands_per_step, &mut rng) {
+                let (rows, tau) = all_bands[b].clone();
+                let splats = match &rolling {
+                    Some(s) => s.clone(),
+                    None => shape.splats_at_time(model, params.clone(), *offset, tau.expect("bands have a time")),
+                };
+                let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
+                let target = rows_tensor(image, rows.clone(), device);
+                let input = LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion: Some(&scaled) };
+                if let Some(term) = losses.evaluate(&input) {
+                    total = Some(match total {
+                        Some(t) => t + term,
+                        None => term,
+                    });
+                    terms += 1;
+                }
+            }
+        }
+        let Some(total) = total else { break };
+        let loss = total / terms as f32;
+        let value = loss.clone().into_scalar::<f32>();
+        let mut grads = loss.backward();
+        if let Some((optim_g, schedule)) = refine.as_mut() {
+            let grads_g = GradientsParams::from_module(&mut grads, &g);
+            g = optim_g.step(schedule.step(), g, grads_g);
+        }
+        let grads = GradientsParams::from_module(&mut grads, &motion);
+        let progress_fraction = step as f64 / fit.iterations.max(1) as f64;
+        let lr = fit.lr_final + (fit.lr - fit.lr_final) * 0.5 * (1.0 + (std::f64::consts::PI * progress_fraction).cos());
+        motion = optim.step(lr, motion, grads);
+        curve.push(value);
+        progress(step + 1, fit.iterations, value);
+    }
+    MotionFit { parameters: motion.si_values(&scales), scales, curve, gaussians: g }
+}

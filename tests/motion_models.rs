@@ -1,0 +1,163 @@
+//! The motion models as tensor programs: they give the poses of FORMAT's laws (checked against
+//! the host implementation used by the generator and the evaluation), their gradients match
+//! finite differences through the whole rolling-shutter render, and the registry builds them by
+//! name.
+
+use burn::tensor::{Device, Tensor, TensorData};
+use rslf::config::MotionConfig;
+use rslf::geometry::{Camera, Pose, TensorCamera, ViewGrid, pose_at};
+use rslf::io::MotionRecord;
+use rslf::model::GaussianSet;
+use rslf::model::motion::{MotionModel, MotionRegistry, MotionSetup};
+use rslf::render::{RenderSettings, RsTiming, StaticShape, render_rolling_shutter};
+
+const READOUT: (f64, f64) = (-0.02, 0.02);
+
+fn host<const D: usize>(t: Tensor<D>) -> Vec<f32> {
+    t.into_data().convert::<f32>().try_to_vec::<f32>().unwrap()
+}
+
+fn model(name: &str, segments: usize) -> Box<dyn MotionModel> {
+    let config = MotionConfig { model: name.into(), segments };
+    MotionRegistry::default().build(&config, &MotionSetup { readout: READOUT }).unwrap()
+}
+
+fn records() -> Vec<(Box<dyn MotionModel>, MotionRecord)> {
+    vec![
+        (model("constant_velocity", 1), MotionRecord::ConstantVelocity { omega_rad_s: [0.3, -0.5, 1.2], velocity_m_s: [0.8, -0.4, 2.0] }),
+        (
+            model("constant_acceleration", 1),
+            MotionRecord::ConstantAcceleration {
+                omega_rad_s: [0.3, -0.5, 0.2],
+                velocity_m_s: [0.8, -0.4, 1.0],
+                alpha_rad_s2: [20.0, 5.0, -30.0],
+                accel_m_s2: [-40.0, 10.0, 25.0],
+            },
+        ),
+        (
+            model("piecewise_constant", 3),
+            MotionRecord::PiecewiseConstant {
+                omega_rad_s: vec![[0.3, 0.0, 0.0], [0.0, -4.0, 0.0], [0.0, 0.0, 5.0]],
+                velocity_m_s: vec![[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 3.0]],
+            },
+        ),
+        (
+            model("piecewise_constant", 4),
+            MotionRecord::PiecewiseConstant {
+                omega_rad_s: vec![[0.3, 0.1, 0.0], [0.0, -4.0, 0.2], [1.0, 0.0, 5.0], [-2.0, 1.0, 0.0]],
+                velocity_m_s: vec![[1.0, 0.0, 0.5], [0.0, 2.0, 0.0], [0.0, -1.0, 3.0], [2.0, 0.0, 0.0]],
+            },
+        ),
+    ]
+}
+
+#[test]
+fn tensor_poses_follow_the_host_laws_of_every_model() {
+    let device = Device::flex();
+    let times = [-0.03, -0.02, -0.011, -0.0067, 0.0, 0.004, 0.0067, 0.013, 0.02, 0.025];
+    for (m, record) in records() {
+        let params = m.parameters_of(&record).expect("the model expresses its own record");
+        assert_eq!(params.len(), m.parameters().len(), "{}", m.name());
+        assert_eq!(m.record(&params), record, "{}: parameters round-trip", m.name());
+        let p = Tensor::<1>::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), &device);
+        let t = Tensor::<1>::from_data(TensorData::new(times.iter().map(|&x| x as f32).collect::<Vec<_>>(), [times.len()]), &device);
+        let poses = m.poses(p, t);
+        let (r, tr) = (host(poses.rotation), host(poses.translation));
+        for (i, &time) in times.iter().enumerate() {
+            let expected: Pose = pose_at(&record, time, READOUT);
+            for a in 0..3 {
+                for b in 0..3 {
+                    let got = r[i * 9 + a * 3 + b] as f64;
+                    assert!((got - expected.rotation[(a, b)]).abs() < 2e-6, "{} t={time} R[{a}{b}] {got} vs {}", m.name(), expected.rotation[(a, b)]);
+                }
+                let got = tr[i * 3 + a] as f64;
+                assert!((got - expected.translation[a]).abs() < 2e-6, "{} t={time} T[{a}] {got} vs {}", m.name(), expected.translation[a]);
+            }
+        }
+    }
+}
+
+#[test]
+fn the_registry_names_its_models_and_refuses_unknown_ones() {
+    let registry = MotionRegistry::default();
+    assert_eq!(registry.names(), vec!["constant_acceleration", "constant_velocity", "piecewise_constant"]);
+    let setup = MotionSetup { readout: READOUT };
+    let err = registry.build(&MotionConfig { model: "helical".into(), segments: 1 }, &setup).err().unwrap().to_string();
+    assert!(err.contains("helical") && err.contains("constant_velocity"), "{err}");
+    let err = registry.build(&MotionConfig { model: "piecewise_constant".into(), segments: 0 }, &setup).err().unwrap().to_string();
+    assert!(err.contains("segments"), "{err}");
+}
+
+fn camera() -> Camera {
+    Camera { grid: ViewGrid { rows: 9, cols: 9 }, width: 24, height: 20, f_px: 60.0, baseline_m: 0.02, focus_m: 2.0, line_time_s: 2e-3 }
+}
+
+fn gaussians() -> GaussianSet {
+    let mut set = GaussianSet { u: vec![], v: vec![], disparity: vec![], size: vec![], colour: vec![], channels: 1 };
+    for i in 0..30 {
+        let f = i as f32;
+        set.u.push(2.0 + (f * 7.3) % 20.0);
+        set.v.push(2.0 + (f * 5.1) % 16.0);
+        set.disparity.push(-0.5 + (f * 0.37) % 1.2);
+        set.size.push(1.2 + (f * 0.23) % 1.0);
+        set.colour.push(0.1 + (f * 0.31) % 0.8);
+    }
+    set
+}
+
+/// Mean colour and disparity of a corner view with rolling shutter, against a fixed pattern.
+fn objective(m: &dyn MotionModel, params: &[f64], timing: RsTiming, device: &Device) -> (Tensor<1>, Tensor<1>) {
+    let cam = camera();
+    let g = gaussians().to_module(device);
+    let p = Tensor::<1>::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), device).require_grad();
+    let shape = StaticShape::new(&g, TensorCamera::new(&cam), m, p.clone());
+    // Every Gaussian in every bin and a footprint out to 6σ: the bins, recomputed in each
+    // evaluation, then cannot change the value (a 3σ cut-off would add jumps of e^-4.5).
+    let settings = RenderSettings { max_per_pixel: 32, cutoff_sigma: 6.0 };
+    let out = render_rolling_shutter(&shape, m, p.clone(), (4.0, 4.0), cam.width, 0..cam.height, timing, &settings, device);
+    let n = out.colour.dims()[0];
+    let pattern = Tensor::<1>::from_data(TensorData::new((0..n).map(|i| ((i * 37 % 11) as f32) / 11.0).collect::<Vec<_>>(), [n]), device);
+    let value = (out.colour.reshape([n]) * pattern.clone()).mean() + (out.disparity * pattern).mean() * 0.1;
+    (value, p)
+}
+
+#[test]
+fn motion_gradients_through_the_rolling_shutter_render_match_finite_differences() {
+    let device = Device::flex().autodiff();
+    let m = model("constant_velocity", 1);
+    let params = [4.0, -3.0, 6.0, 0.5, 0.8, -1.0];
+    for timing in [RsTiming::PerGaussian(3), RsTiming::Bands(4)] {
+        let (value, p) = objective(m.as_ref(), &params, timing, &device);
+        let grad = host(p.grad(&value.backward()).unwrap());
+        for i in 0..params.len() {
+            // A step that moves the image by a few hundredths of a pixel.
+            let h = if i < 3 { 0.05 } else { 0.01 };
+            let at = |s: f64| {
+                let mut q = params;
+                q[i] += s;
+                objective(m.as_ref(), &q, timing, &device).0.into_scalar::<f32>() as f64
+            };
+            let fd = (at(h) - at(-h)) / (2.0 * h);
+            let err = (fd - grad[i] as f64).abs();
+            assert!(err <= 2e-2 * fd.abs() + 1e-5, "{timing:?} parameter {i}: autodiff {} vs finite difference {fd}", grad[i]);
+            assert!(fd.abs() > 1e-5, "{timing:?} parameter {i} has no effect: the check would be empty");
+        }
+    }
+}
+
+#[test]
+fn without_motion_the_rolling_shutter_render_is_the_static_light_field_render() {
+    let device = Device::flex();
+    let cam = camera();
+    let m = model("constant_velocity", 1);
+    let g = gaussians().to_module(&device);
+    let zero = Tensor::<1>::zeros([6], &device);
+    let shape = StaticShape::new(&g, TensorCamera::new(&cam), m.as_ref(), zero.clone());
+    let settings = RenderSettings { max_per_pixel: 8, cutoff_sigma: 3.0 };
+    let offset = (-4.0f32, 4.0f32);
+    let rs = render_rolling_shutter(&shape, m.as_ref(), zero, offset, cam.width, 0..cam.height, RsTiming::Bands(5), &settings, &device);
+    let plain = rslf::render::render_rows(&g, offset, cam.width, 0..cam.height, &settings, &device);
+    let (a, b) = (host(rs.colour), host(plain.colour));
+    let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max);
+    assert!(worst < 1e-4, "largest difference {worst}");
+}
