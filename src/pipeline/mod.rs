@@ -6,6 +6,7 @@ mod plane_sweep;
 mod results;
 mod stage1_fit;
 mod stage2_fit;
+mod targets;
 
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
@@ -119,11 +120,14 @@ pub fn render_central(g: &Gaussians, scene: &Scene, settings: &RenderSettings, f
     central_rasters(render_rows(g, (0.0, 0.0), w, 0..h, settings, device), w, h, c, fallback)
 }
 
+/// A parameter vector as a tensor.
+fn params_tensor(params: &[f64], device: &Device) -> Tensor<1> {
+    Tensor::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), device)
+}
+
 /// The scene at t = 0 under a motion: the Gaussians moved back from their rows' times.
 pub fn static_shape(g: &Gaussians, camera: &Camera, model: &dyn MotionModel, params: &[f64], device: &Device) -> StaticShape {
-    let p: Vec<f32> = params.iter().map(|&x| x as f32).collect();
-    let n = p.len();
-    StaticShape::new(g, TensorCamera::new(camera), model, Tensor::from_data(TensorData::new(p, [n]), device))
+    StaticShape::new(g, TensorCamera::new(camera), model, params_tensor(params, device))
 }
 
 /// Renders the central view at t = 0 of the static shape of `g` under `model` at `params`:
@@ -141,8 +145,7 @@ pub fn render_compensated_central(
 ) -> (Raster, Raster, StaticShape) {
     let (w, h, c) = (scene.width(), scene.height(), scene.channels());
     let shape = static_shape(g, camera, model, params, device);
-    let tensor_params = Tensor::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), device);
-    let splats = shape.splats_at_time(model, tensor_params, (0.0, 0.0), 0.0);
+    let splats = shape.splats_at_time(model, params_tensor(params, device), (0.0, 0.0), 0.0);
     let out = splat(&splats, &splats.bins(w, 0..h, settings), device);
     let (colour, disparity) = central_rasters(out, w, h, c, fallback);
     (colour, disparity, shape)

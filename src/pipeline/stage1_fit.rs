@@ -1,6 +1,7 @@
 //! Stage-1 fit: Adam on every Gaussian parameter against views of the central row (which hold no
 //! motion), one learning rate per parameter group.
 
+use super::targets::{band_tensor, view_targets};
 use crate::geometry::ViewId;
 use crate::io::{Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
@@ -46,13 +47,6 @@ pub fn image_tensor(img: &Raster, device: &Device) -> Tensor<2> {
     Tensor::from_data(TensorData::new(img.data.clone(), [img.pixels(), img.channels]), device)
 }
 
-/// Rows `rows` of a view as a `[P, C]` tensor.
-fn band_tensor(img: &Raster, rows: std::ops::Range<usize>, device: &Device) -> Tensor<2> {
-    let (w, c) = (img.width, img.channels);
-    let data = img.data[rows.start * w * c..rows.end * w * c].to_vec();
-    Tensor::from_data(TensorData::new(data, [rows.len() * w, c]), device)
-}
-
 /// The per-group learning-rate policy of `g`.
 pub(crate) fn lr_policy(g: &Gaussians, lr: &LearningRates) -> ModuleLrScheduler {
     let group = |id| ParamGroup::from_ids(vec![id]);
@@ -81,13 +75,7 @@ pub fn fit_stage1(
 ) -> (Gaussians, Vec<f32>) {
     let (w, h) = (scene.width(), scene.height());
     assert!(!views.is_empty(), "stage 1 needs at least one view");
-    let targets: Vec<((f32, f32), &Raster)> = views
-        .iter()
-        .filter_map(|&v| {
-            let (dx, dy) = scene.grid.offset(v);
-            Some(((dx as f32, dy as f32), scene.view(v)?))
-        })
-        .collect();
+    let targets = view_targets(scene, views);
     let band = fit.band_height.clamp(1, h);
     let bands: Vec<std::ops::Range<usize>> = (0..h).step_by(band).map(|y| y..(y + band).min(h)).collect();
     // Band targets are cut once: `[P, C]` per (band, view).

@@ -2,8 +2,9 @@
 //! lifts the Gaussians, moves them back to t = 0 under the current motion, re-images them with
 //! rolling shutter into each view and compares a stratified sample of row bands.
 
+use super::targets::{band_tensor, view_targets};
 use crate::geometry::{Camera, TensorCamera, ViewId};
-use crate::io::{Raster, Scene};
+use crate::io::Scene;
 use crate::loss::{LossInput, WeightedLosses};
 use super::stage1_fit::{LearningRates, lr_policy};
 use crate::model::Gaussians;
@@ -12,7 +13,7 @@ use crate::random::Rng;
 use crate::render::{RenderSettings, RsTiming, StaticShape, bands, splat};
 use burn::module::Module;
 use burn::optim::{AdamConfig, GradientsParams};
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::{Device, Tensor};
 
 /// Settings of the stage-2 fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -86,13 +87,6 @@ fn stratified(total: usize, count: usize, rng: &mut Rng) -> Vec<usize> {
         .collect()
 }
 
-/// Rows `rows` of a view as a `[P, C]` tensor.
-fn rows_tensor(img: &Raster, rows: std::ops::Range<usize>, device: &Device) -> Tensor<2> {
-    let (w, c) = (img.width, img.channels);
-    let data = img.data[rows.start * w * c..rows.end * w * c].to_vec();
-    Tensor::from_data(TensorData::new(data, [rows.len() * w, c]), device)
-}
-
 /// Fits `model`'s parameters, starting from `start` (SI), to `views` of `scene`; the Gaussians
 /// `g` are held fixed unless `fit.refine` is set. `progress(step, total, loss)` is called after
 /// each step.
@@ -116,13 +110,10 @@ pub fn fit_stage2(
     let mut motion = MotionParams::new(start, &scales, device);
     let w = scene.width();
     let all_bands = bands(0..scene.height(), RsTiming::Bands(fit.band_height), &tc);
-    let targets: Vec<((f32, f32), &Raster)> = views
-        .iter()
-        .filter_map(|&v| {
-            let (dx, dy) = scene.grid.offset(v);
-            Some(((dx as f32, dy as f32), scene.view(v)?))
-        })
-        .collect();
+    let targets = view_targets(scene, views);
+    // Band targets are cut once: `[P, C]` per (view, band).
+    let band_targets: Vec<Vec<Tensor<2>>> =
+        targets.iter().map(|(_, img)| all_bands.iter().map(|(rows, _)| band_tensor(img, rows.clone(), device)).collect()).collect();
     let mut optim = AdamConfig::new().with_epsilon(fit.adam_epsilon).init();
     let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
     let mut curve = Vec::with_capacity(fit.iterations);
@@ -132,7 +123,7 @@ pub fn fit_stage2(
         let scaled = motion.scaled.val();
         let mut total: Option<Tensor<1>> = None;
         let mut terms = 0usize;
-        for (offset, image) in &targets {
+        for ((offset, _), view_bands) in targets.iter().zip(&band_targets) {
             let rolling = match fit.timing {
                 RsTiming::PerGaussian(iterations) => Some(shape.splats_rolling(model, params.clone(), *offset, iterations)),
                 RsTiming::Bands(_) => None,
@@ -144,8 +135,7 @@ pub fn fit_stage2(
                     None => shape.splats_at_time(model, params.clone(), *offset, tau.expect("bands have a time")),
                 };
                 let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
-                let target = rows_tensor(image, rows.clone(), device);
-                let input = LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion: Some(&scaled) };
+                let input = LossInput { rendered: &out, target: &view_bands[b], rows: rows.len(), width: w, motion: Some(&scaled) };
                 if let Some(term) = losses.evaluate(&input) {
                     total = Some(match total {
                         Some(t) => t + term,
