@@ -5,9 +5,17 @@
 //! al., "Dense Scene Reconstruction from Light-Field Images Affected by Rolling Shutter",
 //! WACV 2025).
 //!
-//! Layers, bottom to top: [`io`] (files), [`geometry`] (the camera model), [`config`] (run
-//! settings), [`pipeline`] (the RSLF composition), [`eval`] (metrics), [`cli`] (the `rslf`
-//! command).
+//! Layers, bottom to top: [`io`] (files), [`geometry`] (the camera model, host and tensor
+//! versions), [`model`] (the Gaussians and the motion models, as burn modules and tensor
+//! programs), [`render`] (the differentiable light-field renderer), [`loss`] (loss terms and
+//! their registry), [`optim`] (generic optimisation stages), [`pipeline`] (the RSLF
+//! composition of those pieces), [`eval`] (metrics), [`cli`] (the `rslf` command). Beside them:
+//! [`config`] (run settings), [`synth`] (the scene generator), [`device`] (the backend).
+//!
+//! `docs/extending.md` shows how to add a loss term, a motion model or a stage from outside the
+//! crate; `examples/` holds one program for each.
+
+#![warn(missing_docs)]
 
 pub mod cli;
 pub mod config;
@@ -18,6 +26,7 @@ pub mod geometry;
 pub mod io;
 pub mod loss;
 pub mod model;
+pub mod optim;
 pub mod pipeline;
 pub mod progress;
 pub mod random;

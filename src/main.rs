@@ -1,13 +1,5 @@
-use clap::Parser;
-use std::process::ExitCode;
+//! The `rslf` command: the built-in loss terms and motion models.
 
-fn main() -> ExitCode {
-    let cli = rslf::cli::Cli::parse();
-    match rslf::cli::run(cli) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(err) => {
-            eprintln!("error: {err}");
-            ExitCode::FAILURE
-        }
-    }
+fn main() -> std::process::ExitCode {
+    rslf::cli::main_with(&rslf::pipeline::Registries::default())
 }

@@ -120,7 +120,7 @@ fn the_same_config_and_seed_give_the_same_stage_one_result_twice_on_flex() {
         std::path::Path::new("test.toml"),
     )
     .unwrap();
-    let device = rslf::device::device(config.device);
+    let device = rslf::device::device(config.device).unwrap();
     let (a, _) = rslf::pipeline::run(&config, &scene, &device).unwrap();
     let (b, _) = rslf::pipeline::run(&config, &scene, &device).unwrap();
     assert_eq!(a.disparity, b.disparity);

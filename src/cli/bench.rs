@@ -58,7 +58,7 @@ pub fn run(args: BenchArgs) -> crate::Result<()> {
     let offset = (-2.0, 0.0);
     println!("render: {s}x{s} px, {n} Gaussians, K = {}, view offset {offset:?}", settings.max_per_pixel);
     for &choice in &args.devices {
-        let device = crate::device::device(choice);
+        let device = crate::device::device(choice)?;
         let start = Instant::now();
         let bins = bins_for_view(&set, offset, s, 0..s, &settings);
         let binning = start.elapsed().as_secs_f64();
@@ -100,7 +100,7 @@ pub fn run(args: BenchArgs) -> crate::Result<()> {
         let loaded = loaded?;
         let mut config = Config::default();
         config.stage1.gaussians = n;
-        let device = crate::device::device(DeviceChoice::Flex);
+        let device = crate::device::device(DeviceChoice::Flex)?;
         let start = Instant::now();
         let (_, log) = crate::pipeline::run(&config, &loaded, &device)?;
         println!("stage 1 on the generated `objects` scene ({s}x{s}, 81 views generated in {generated:.1} s), flex:");

@@ -1,6 +1,6 @@
 //! `rslf train CONFIG [--scene DIR] [--out DIR]`.
 
-use crate::config::Config;
+use crate::config::{Config, DeviceChoice};
 use crate::io::{GroundTruth, Scene};
 use crate::model::SavedModel;
 use crate::pipeline;
@@ -17,6 +17,9 @@ pub struct TrainArgs {
     /// Result folder; overrides the config's `out`.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Device; overrides the config's `device`.
+    #[arg(long, value_enum)]
+    pub device: Option<DeviceChoice>,
     /// Folder of saved models; the fitted model goes to MODELS/<result folder name>/model.json.
     #[arg(long, default_value = "models")]
     pub models: PathBuf,
@@ -24,9 +27,8 @@ pub struct TrainArgs {
 
 /// Loads config and scene, runs the pipeline, writes the result folder (and `metrics.json`
 /// when the scene has ground truth).
-pub fn run(args: TrainArgs) -> crate::Result<()> {
+pub fn run(args: TrainArgs, registries: &pipeline::Registries) -> crate::Result<()> {
     let config = Config::read(&args.config)?;
-    let registries = pipeline::Registries::default();
     registries.check(&config).map_err(|e| crate::Error::Usage(format!("{}: {e}", args.config.display())))?;
     let scene_dir = args.scene.or(config.scene.clone()).ok_or_else(|| {
         crate::Error::Usage(format!("{}: no scene: set `scene` in the config or pass --scene DIR", args.config.display()))
@@ -39,6 +41,7 @@ pub fn run(args: TrainArgs) -> crate::Result<()> {
         Some(name) => crate::synth::builtin_scene(name)?,
         None => scene_dir,
     };
+    let device = crate::device::device(args.device.unwrap_or(config.device))?;
     let scene = Scene::load(&scene_dir)?;
     let gt = GroundTruth::load(&scene_dir, scene.width(), scene.height())?;
     println!(
@@ -55,8 +58,7 @@ pub fn run(args: TrainArgs) -> crate::Result<()> {
             (Some(_), false) => "global shutter".to_string(),
         }
     );
-    let device = crate::device::device(config.device);
-    let (result, log) = pipeline::run_with(&config, &scene, &device, &registries)?;
+    let (result, log) = pipeline::run_with(&config, &scene, &device, registries)?;
     for line in &log.lines {
         println!("{line}");
     }
@@ -68,7 +70,7 @@ pub fn run(args: TrainArgs) -> crate::Result<()> {
         let name = out.file_name().map_or("run".into(), |n| n.to_string_lossy().into_owned());
         let size = [scene.width(), scene.height()];
         let grid = [scene.grid.rows, scene.grid.cols];
-        let model = SavedModel::new(&scene_dir, size, grid, gaussians.clone(), result.motion.as_ref());
+        let model = SavedModel::new(&scene_dir, size, grid, gaussians.clone(), result.motion.as_ref(), scene.params.as_ref());
         let path = model.save(&args.models.join(name))?;
         println!("wrote {}", path.display());
     }

@@ -78,6 +78,9 @@ pub struct Stage1Config {
     /// Adam's epsilon (measured on HCI antinous: 1e-15 lets disparities random-walk, BadPix(0.07)
     /// 50.7%; 1e-5 gives 24.7%).
     pub adam_epsilon: f64,
+    /// A disparity map (PFM, the central view's size) to start from instead of the plane sweep,
+    /// e.g. another method's estimate, or the ground truth for an ablation.
+    pub initial_disparity: Option<PathBuf>,
 }
 
 impl Default for Stage1Config {
@@ -94,6 +97,7 @@ impl Default for Stage1Config {
             lr_size: 0.01,
             lr_colour: 0.01,
             adam_epsilon: 1e-5,
+            initial_disparity: None,
         }
     }
 }

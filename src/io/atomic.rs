@@ -32,3 +32,28 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> IoResult<()> {
 pub fn create_dir_all(dir: &Path) -> IoResult<()> {
     std::fs::create_dir_all(dir).map_err(|e| IoError::os(dir, e))
 }
+
+/// Writes the folder `out` whole or not at all: `fill` writes into a temporary sibling folder,
+/// which is renamed to `out` once complete. An existing `out` is replaced only when `replace`
+/// is set.
+pub fn write_folder(out: &Path, replace: bool, fill: impl FnOnce(&Path) -> IoResult<()>) -> IoResult<()> {
+    if out.exists() && !replace {
+        return Err(IoError::new(out, "already exists (pass --force to replace it)"));
+    }
+    let name = out.file_name().ok_or_else(|| IoError::new(out, "not a folder path"))?.to_string_lossy();
+    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    create_dir_all(parent)?;
+    let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+    if tmp.exists() {
+        std::fs::remove_dir_all(&tmp).map_err(|e| IoError::os(&tmp, e))?;
+    }
+    let filled = create_dir_all(&tmp).and_then(|_| fill(&tmp));
+    if let Err(e) = filled {
+        let _ = std::fs::remove_dir_all(&tmp);
+        return Err(e);
+    }
+    if out.exists() {
+        std::fs::remove_dir_all(out).map_err(|e| IoError::os(out, e))?;
+    }
+    std::fs::rename(&tmp, out).map_err(|e| IoError::os(out, e))
+}

@@ -11,7 +11,7 @@ mod pfm;
 mod raster;
 mod scene;
 
-pub use atomic::{create_dir_all, write_atomic};
+pub use atomic::{create_dir_all, write_atomic, write_folder};
 pub use error::{IoError, IoResult};
 pub use ground_truth::{GroundTruth, read_if_present};
 pub use image_file::{read_image, write_mask_png, write_png};

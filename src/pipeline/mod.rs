@@ -2,6 +2,7 @@
 //! then stage 2 (motion) as it arrives, and the result.
 
 mod gaussian_init;
+mod light_field;
 mod plane_sweep;
 mod results;
 mod stage1_fit;
@@ -9,9 +10,10 @@ mod stage2_fit;
 mod targets;
 
 pub use gaussian_init::{frequency_map, sample_gaussians};
+pub use light_field::{Moment, motion_of_record, render_light_field};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{PointCloud, RunResult, depth_map};
-pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor};
+pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
 pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales};
 
 use crate::config::{Config, TimingChoice, ViewSelection};
@@ -170,7 +172,7 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
         None => None,
     };
     let mut log = RunLog::default();
-    let (gaussians, initial, mut curves) = stage1(config, scene, &losses, device, &mut log);
+    let (gaussians, initial, mut curves) = stage1(config, scene, &losses, device, &mut log)?;
     let render = render_settings(config);
 
     let initial_motion = match &config.stage2.initial_motion {
@@ -224,25 +226,33 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
 
 /// Stage 1: plane sweep, sampling and fit. Returns the Gaussians, the initial disparity map
 /// (the fallback where the render is transparent) and the loss curve.
-fn stage1(config: &Config, scene: &Scene, losses: &WeightedLosses, device: &Device, log: &mut RunLog) -> (Gaussians, Raster, Vec<(String, Vec<f32>)>) {
-    let settings = sweep_settings(config, scene);
-    let row_views = scene.central_row_views();
-    let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
-    let bar = crate::progress::bar(labels, "stage 1: sweep");
+fn stage1(
+    config: &Config,
+    scene: &Scene,
+    losses: &WeightedLosses,
+    device: &Device,
+    log: &mut RunLog,
+) -> crate::Result<(Gaussians, Raster, Vec<(String, Vec<f32>)>)> {
+    let initial = match &config.stage1.initial_disparity {
+        Some(path) => {
+            let map = crate::io::read_pfm(path)?;
+            if (map.width, map.height) != (scene.width(), scene.height()) {
+                return Err(crate::Error::Usage(format!(
+                    "config: stage1.initial_disparity {} is {}x{}, the views are {}x{}",
+                    path.display(),
+                    map.width,
+                    map.height,
+                    scene.width(),
+                    scene.height()
+                )));
+            }
+            log.lines.push(format!("stage 1 initialisation: disparity from {}", path.display()));
+            map
+        }
+        None => sweep(config, scene, log),
+    };
     let start = Instant::now();
-    let estimate = plane_sweep(scene, &row_views, &settings, |done, _| bar.set_position(done as u64));
-    bar.finish_and_clear();
-    log.lines.push(format!(
-        "stage 1 initialisation: plane sweep over {} central-row views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
-        row_views.len(),
-        settings.range.0,
-        settings.range.1,
-        labels,
-        start.elapsed().as_secs_f64()
-    ));
-
-    let start = Instant::now();
-    let set = sample_gaussians(scene.central(), &estimate.disparity, config.stage1.gaussians, config.seed);
+    let set = sample_gaussians(scene.central(), &initial, config.stage1.gaussians, config.seed);
     let mut gaussians = set.to_module(device);
     log.lines.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
 
@@ -277,7 +287,7 @@ fn stage1(config: &Config, scene: &Scene, losses: &WeightedLosses, device: &Devi
         ));
         curves.push(("stage1".to_string(), curve));
     }
-    (gaussians, estimate.disparity, curves)
+    Ok((gaussians, initial, curves))
 }
 
 /// Stage 2: the motion, fitted against the off-row views.
@@ -333,4 +343,25 @@ fn stage2(
         start.elapsed().as_secs_f64()
     ));
     fitted
+}
+
+/// The plane sweep over the central row: the initial disparity map.
+fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
+    let settings = sweep_settings(config, scene);
+    let row_views = scene.central_row_views();
+    let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
+    let bar = crate::progress::bar(labels, "stage 1: sweep");
+    let start = Instant::now();
+    let estimate = plane_sweep(scene, &row_views, &settings, |done, _| bar.set_position(done as u64));
+    bar.finish_and_clear();
+    log.lines.push(format!(
+        "stage 1 initialisation: plane sweep over {} central-row views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
+        row_views.len(),
+        settings.range.0,
+        settings.range.1,
+        labels,
+        start.elapsed().as_secs_f64()
+    ));
+
+    estimate.disparity
 }

@@ -7,10 +7,7 @@ use crate::io::{Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
 use crate::model::Gaussians;
 use crate::render::{RenderSettings, bins_for_view, render};
-use burn::module::ParamGroup;
-use burn::optim::lr_scheduler::LrSchedulerConfig;
-use burn::optim::lr_scheduler::module_lr_scheduler::{ModuleLrScheduler, ModuleLrSchedulerConfig};
-use burn::optim::{AdamConfig, GradientsParams};
+use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// Learning rates of the four parameter groups (units of the parameter per step).
@@ -47,16 +44,13 @@ pub fn image_tensor(img: &Raster, device: &Device) -> Tensor<2> {
     Tensor::from_data(TensorData::new(img.data.clone(), [img.pixels(), img.channels]), device)
 }
 
-/// The per-group learning-rate policy of `g`.
-pub(crate) fn lr_policy(g: &Gaussians, lr: &LearningRates) -> ModuleLrScheduler {
-    let group = |id| ParamGroup::from_ids(vec![id]);
-    ModuleLrSchedulerConfig::new(LrSchedulerConfig::Constant(lr.position))
-        .with_group(group(g.centre.id), LrSchedulerConfig::Constant(lr.position))
-        .with_group(group(g.disparity.id), LrSchedulerConfig::Constant(lr.disparity))
-        .with_group(group(g.log_size.id), LrSchedulerConfig::Constant(lr.size))
-        .with_group(group(g.colour.id), LrSchedulerConfig::Constant(lr.colour))
-        .init()
-        .expect("constant schedules are valid")
+/// `plan` with the Gaussians' four parameter groups added: constant rates, one epsilon.
+pub fn with_gaussian_groups(plan: Plan, g: &Gaussians, lr: &LearningRates, adam_epsilon: f32) -> Plan {
+    let group = |lr| GroupPlan { schedule: Schedule::Constant(lr), adam_epsilon };
+    plan.with_group([g.centre.id], group(lr.position))
+        .with_group([g.disparity.id], group(lr.disparity))
+        .with_group([g.log_size.id], group(lr.size))
+        .with_group([g.colour.id], group(lr.colour))
 }
 
 /// Fits `g` to `views` of `scene` under `losses`; returns the fitted Gaussians and the loss of
@@ -65,7 +59,7 @@ pub(crate) fn lr_policy(g: &Gaussians, lr: &LearningRates) -> ModuleLrScheduler 
 /// point on the same row), so that every step weighs all the disparity cues; bands are taken
 /// in turn. `progress(step, total, loss)` is called after each step.
 pub fn fit_stage1(
-    mut g: Gaussians,
+    g: Gaussians,
     scene: &Scene,
     views: &[ViewId],
     fit: &Stage1Fit,
@@ -83,30 +77,18 @@ pub fn fit_stage1(
         .iter()
         .map(|rows| targets.iter().map(|(_, img)| band_tensor(img, rows.clone(), device)).collect())
         .collect();
-    let mut optim = AdamConfig::new().with_epsilon(fit.adam_epsilon).init();
-    let mut schedule = lr_policy(&g, &fit.lr);
-    let mut curve = Vec::with_capacity(fit.iterations);
-    for step in 0..fit.iterations {
+    let default = GroupPlan { schedule: Schedule::Constant(fit.lr.position), adam_epsilon: fit.adam_epsilon };
+    let stage = Stage { iterations: fit.iterations, plan: with_gaussian_groups(Plan::new(default), &g, &fit.lr, fit.adam_epsilon) };
+    let objective = |g: &Gaussians, step: usize| {
         let b = step % bands.len();
         let set = g.to_set();
-        let mut loss: Option<Tensor<1>> = None;
+        let mut loss = MeanLoss::default();
         for ((offset, _), target) in targets.iter().zip(&band_targets[b]) {
             let bins = bins_for_view(&set, *offset, w, bands[b].clone(), &fit.render);
-            let out = render(&g, *offset, &bins, device);
-            let input = LossInput { rendered: &out, target, rows: bands[b].len(), width: w, motion: None };
-            let Some(term) = losses.evaluate(&input) else { continue };
-            loss = Some(match loss {
-                Some(l) => l + term,
-                None => term,
-            });
+            let out = render(g, *offset, &bins, device);
+            loss.add(losses.evaluate(&LossInput { rendered: &out, target, rows: bands[b].len(), width: w, motion: None }));
         }
-        let Some(loss) = loss else { break };
-        let loss = loss / targets.len() as f32;
-        let value = loss.clone().into_scalar::<f32>();
-        let grads = GradientsParams::from_grads(loss.backward(), &g);
-        g = optim.step(schedule.step(), g, grads);
-        curve.push(value);
-        progress(step + 1, fit.iterations, value);
-    }
-    (g, curve)
+        loss.mean()
+    };
+    optimise(g, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss))
 }

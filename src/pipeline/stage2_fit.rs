@@ -6,13 +6,13 @@ use super::targets::{band_tensor, view_targets};
 use crate::geometry::{Camera, TensorCamera, ViewId};
 use crate::io::Scene;
 use crate::loss::{LossInput, WeightedLosses};
-use super::stage1_fit::{LearningRates, lr_policy};
+use super::stage1_fit::{LearningRates, with_gaussian_groups};
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionParams, ScaleContext, parameter_scales};
+use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
 use crate::random::Rng;
 use crate::render::{RenderSettings, RsTiming, StaticShape, bands, splat};
 use burn::module::Module;
-use burn::optim::{AdamConfig, GradientsParams};
 use burn::tensor::{Device, Tensor};
 
 /// Settings of the stage-2 fit.
@@ -53,6 +53,14 @@ pub struct MotionFit {
     pub curve: Vec<f32>,
     /// The Gaussians: refined with joint refinement, else as given.
     pub gaussians: Gaussians,
+}
+
+/// What stage 2 optimises: the scaled motion parameters and the Gaussians (frozen unless the
+/// fit refines them).
+#[derive(Module, Debug)]
+struct MotionAndScene {
+    motion: MotionParams,
+    gaussians: Gaussians,
 }
 
 /// The scales of `model`'s parameters for a scene: one unit moves a point at the Gaussians'
@@ -103,26 +111,31 @@ pub fn fit_stage2(
     device: &Device,
     mut progress: impl FnMut(usize, usize, f32),
 ) -> MotionFit {
-    let mut g = if fit.refine.is_some() { g } else { g.no_grad() };
-    let mut refine = fit.refine.map(|(lr, eps)| (AdamConfig::new().with_epsilon(eps).init(), lr_policy(&g, &lr)));
+    let g = if fit.refine.is_some() { g } else { g.no_grad() };
     let tc = TensorCamera::new(camera);
     let scales = motion_scales(model, &g, camera);
-    let mut motion = MotionParams::new(start, &scales, device);
     let w = scene.width();
     let all_bands = bands(0..scene.height(), RsTiming::Bands(fit.band_height), &tc);
     let targets = view_targets(scene, views);
     // Band targets are cut once: `[P, C]` per (view, band).
     let band_targets: Vec<Vec<Tensor<2>>> =
         targets.iter().map(|(_, img)| all_bands.iter().map(|(rows, _)| band_tensor(img, rows.clone(), device)).collect()).collect();
-    let mut optim = AdamConfig::new().with_epsilon(fit.adam_epsilon).init();
+    let motion_plan = GroupPlan {
+        schedule: Schedule::Cosine { start: fit.lr, end: fit.lr_final, steps: fit.iterations },
+        adam_epsilon: fit.adam_epsilon,
+    };
+    let plan = match &fit.refine {
+        Some((lr, eps)) => with_gaussian_groups(Plan::new(motion_plan), &g, lr, *eps),
+        None => Plan::new(motion_plan),
+    };
+    let stage = Stage { iterations: fit.iterations, plan };
+    let start = MotionAndScene { motion: MotionParams::new(start, &scales, device), gaussians: g };
     let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
-    let mut curve = Vec::with_capacity(fit.iterations);
-    for step in 0..fit.iterations {
-        let params = motion.si(&scales);
-        let shape = StaticShape::new(&g, tc, model, params.clone());
-        let scaled = motion.scaled.val();
-        let mut total: Option<Tensor<1>> = None;
-        let mut terms = 0usize;
+    let objective = |m: &MotionAndScene, _step: usize| {
+        let params = m.motion.si(&scales);
+        let shape = StaticShape::new(&m.gaussians, tc, model, params.clone());
+        let scaled = m.motion.scaled.val();
+        let mut loss = MeanLoss::default();
         for ((offset, _), view_bands) in targets.iter().zip(&band_targets) {
             let rolling = match fit.timing {
                 RsTiming::PerGaussian(iterations) => Some(shape.splats_rolling(model, params.clone(), *offset, iterations)),
@@ -136,29 +149,11 @@ pub fn fit_stage2(
                 };
                 let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
                 let input = LossInput { rendered: &out, target: &view_bands[b], rows: rows.len(), width: w, motion: Some(&scaled) };
-                if let Some(term) = losses.evaluate(&input) {
-                    total = Some(match total {
-                        Some(t) => t + term,
-                        None => term,
-                    });
-                    terms += 1;
-                }
+                loss.add(losses.evaluate(&input));
             }
         }
-        let Some(total) = total else { break };
-        let loss = total / terms as f32;
-        let value = loss.clone().into_scalar::<f32>();
-        let mut grads = loss.backward();
-        if let Some((optim_g, schedule)) = refine.as_mut() {
-            let grads_g = GradientsParams::from_module(&mut grads, &g);
-            g = optim_g.step(schedule.step(), g, grads_g);
-        }
-        let grads = GradientsParams::from_module(&mut grads, &motion);
-        let progress_fraction = step as f64 / fit.iterations.max(1) as f64;
-        let lr = fit.lr_final + (fit.lr - fit.lr_final) * 0.5 * (1.0 + (std::f64::consts::PI * progress_fraction).cos());
-        motion = optim.step(lr, motion, grads);
-        curve.push(value);
-        progress(step + 1, fit.iterations, value);
-    }
-    MotionFit { parameters: motion.si_values(&scales), scales, curve, gaussians: g }
+        loss.mean()
+    };
+    let (fitted, curve) = optimise(start, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
+    MotionFit { parameters: fitted.motion.si_values(&scales), scales, curve, gaussians: fitted.gaussians }
 }

@@ -25,11 +25,22 @@ pub fn cache_dir() -> PathBuf {
 /// The folder of built-in scene `name` (a suite entry such as `checkerboards_slow1`), generated
 /// at its default size when not yet in the cache.
 pub fn builtin_scene(name: &str) -> IoResult<PathBuf> {
-    let dir = cache_dir().join("scenes").join(name);
+    builtin_scene_sized(name, None)
+}
+
+/// The folder of built-in scene `name` at `size` (`[W, H]`; `None`: the default size, 512x512),
+/// generated when not yet in the cache. The suite's motions are set for 512 px and their pixel
+/// shifts scale with the width (a 64 px scene moves 1/8 as many pixels).
+pub fn builtin_scene_sized(name: &str, size: Option<[usize; 2]>) -> IoResult<PathBuf> {
+    let folder = match size {
+        Some([w, h]) => format!("{name}_{w}x{h}"),
+        None => name.to_string(),
+    };
+    let dir = cache_dir().join("scenes").join(folder);
     if dir.join("parameters.cfg").exists() {
         return Ok(dir);
     }
-    let options = GenerateOptions::default();
+    let options = GenerateOptions { size, ..GenerateOptions::default() };
     let entries = suite(&options)?;
     let entry = entries.iter().find(|e| e.name == name).ok_or_else(|| {
         let names: Vec<&str> = entries.iter().map(|e| e.name.as_str()).collect();

@@ -6,8 +6,7 @@ use super::truth::{Truth, ground_truth};
 use super::world::World;
 use crate::geometry::Camera;
 use crate::io::{
-    IoError, IoResult, MotionRecord, Raster, SceneParameters, create_dir_all, view_file_name, write_mask_png, write_pfm,
-    write_png,
+    IoResult, MotionRecord, Raster, SceneParameters, view_file_name, write_folder, write_mask_png, write_pfm, write_png,
 };
 use std::path::Path;
 
@@ -87,29 +86,10 @@ impl GeneratedScene {
     /// Writes the scene folder `out`: views, `parameters.cfg`, ground truth. The folder appears
     /// only once complete; an existing `out` is replaced only when `replace` is set.
     pub fn write(&self, out: &Path, replace: bool) -> IoResult<()> {
-        if out.exists() && !replace {
-            return Err(IoError::new(out, "already exists (pass --force to replace it)"));
-        }
-        let name = out.file_name().ok_or_else(|| IoError::new(out, "not a folder path"))?.to_string_lossy();
-        let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        create_dir_all(parent)?;
-        let tmp = parent.join(format!(".{name}.partial-{}", std::process::id()));
-        if tmp.exists() {
-            std::fs::remove_dir_all(&tmp).map_err(|e| IoError::os(&tmp, e))?;
-        }
-        let written = self.write_files(&tmp);
-        if let Err(e) = written {
-            let _ = std::fs::remove_dir_all(&tmp);
-            return Err(e);
-        }
-        if out.exists() {
-            std::fs::remove_dir_all(out).map_err(|e| IoError::os(out, e))?;
-        }
-        std::fs::rename(&tmp, out).map_err(|e| IoError::os(out, e))
+        write_folder(out, replace, |dir| self.write_files(dir))
     }
 
     fn write_files(&self, dir: &Path) -> IoResult<()> {
-        create_dir_all(dir)?;
         for (i, view) in self.views.iter().enumerate() {
             write_png(&dir.join(view_file_name(i)), view)?;
         }

@@ -138,17 +138,17 @@ pub fn parameter_scales(kinds: &[ParamKind], ctx: &ScaleContext) -> Vec<f64> {
 }
 
 /// Entries `at..at + 3` of a parameter vector as a `[1, 3]` row.
-pub(crate) fn vec3(params: &Tensor<1>, at: usize) -> Tensor<2> {
+pub fn vec3(params: &Tensor<1>, at: usize) -> Tensor<2> {
     params.clone().slice([at..at + 3]).reshape([1, 3])
 }
 
 /// `times ⊗ row`: `[N]` times a `[1, 3]` row gives `[N, 3]`.
-pub(crate) fn scale_rows(times: &Tensor<1>, row: Tensor<2>) -> Tensor<2> {
+pub fn scale_rows(times: &Tensor<1>, row: Tensor<2>) -> Tensor<2> {
     let n = times.dims()[0];
     times.clone().reshape([n, 1]) * row
 }
 
 /// Three SI values from a host vector.
-pub(crate) fn three(v: &[f64], at: usize) -> [f64; 3] {
+pub fn three(v: &[f64], at: usize) -> [f64; 3] {
     [v[at], v[at + 1], v[at + 2]]
 }

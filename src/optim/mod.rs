@@ -1,0 +1,18 @@
+//! Generic optimisation stages: which parameters move, at which learning rates, under which
+//! objective, for how many steps.
+//!
+//! A stage is a burn [`Module`](burn::module::Module) (the model's parameters), a [`Plan`] (Adam
+//! with a learning-rate [`Schedule`] and epsilon per parameter group), and an [`Objective`]
+//! (a function from the model to a scalar loss on the autodiff graph). [`optimise`] runs it.
+//! Both RSLF stages are compositions of these pieces (`pipeline::fit_stage1`,
+//! `pipeline::fit_stage2`); `examples/fit_image.rs` uses them to fit 2D Gaussians to one image.
+
+mod mean_loss;
+mod plan;
+mod schedule;
+mod stage;
+
+pub use mean_loss::MeanLoss;
+pub use plan::{GroupPlan, Optimiser, Plan};
+pub use schedule::Schedule;
+pub use stage::{Objective, Stage, StepReport, optimise};

@@ -1,0 +1,40 @@
+//! `rslf ablation` end to end on the smallest suite: one base scene, static plus one slow and one
+//! fast direction, at 32x32 px with a few steps per stage.
+
+mod common;
+
+use common::rslf_with_env;
+
+#[test]
+fn the_ablation_prints_and_writes_the_four_row_table() {
+    let root = common::tempdir();
+    let config = root.path().join("small.toml");
+    std::fs::write(&config, "[stage1]\ngaussians = 300\niterations = 5\nband_height = 16\n[stage2]\niterations = 3\nbands_per_step = 1\n").unwrap();
+    let out = root.path().join("ablation");
+    let (ok, stdout, stderr) = rslf_with_env(
+        &["ablation", config.to_str().unwrap(), "--size", "32", "--bases", "objects", "--directions", "1", "--out", out.to_str().unwrap()],
+        &[("RSLF_CACHE_DIR", &root.path().join("cache"))],
+    );
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("ablation: 3 scenes x 4 variants at 32x32 px"), "{stdout}");
+    let table = std::fs::read_to_string(out.join("ablation.md")).unwrap();
+    assert!(stdout.contains(&table), "the printed table is the written one");
+    let rows: Vec<&str> = table.lines().skip(2).collect();
+    let names: Vec<&str> = rows.iter().map(|r| r.split('|').nth(1).unwrap().trim()).collect();
+    assert_eq!(names, ["no init, no motion", "no motion", "no init", "full"]);
+    for row in &rows {
+        let cells: Vec<f64> = row.split('|').skip(2).filter(|c| !c.trim().is_empty()).map(|c| c.trim().parse().unwrap()).collect();
+        assert_eq!(cells.len(), 6, "{row}");
+        assert!(cells.iter().all(|v| v.is_finite() && *v >= 0.0), "{row}");
+    }
+    let csv = std::fs::read_to_string(out.join("ablation.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 3 * 4, "{csv}");
+    // Only the variants with stage 2 estimate a motion.
+    for line in csv.lines().skip(1) {
+        let fields: Vec<&str> = line.split(',').collect();
+        let moving_variant = fields[2] == "no init" || fields[2] == "full";
+        assert_eq!(!fields[5].is_empty(), moving_variant, "{line}");
+    }
+    // The result folders are there for inspection.
+    assert!(out.join("objects_static/full/central.png").exists());
+}
