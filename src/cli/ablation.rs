@@ -7,7 +7,7 @@ use crate::config::Config;
 use crate::eval::evaluate;
 use crate::io::{Scene, write_atomic};
 use crate::pipeline;
-use crate::synth::{GenerateOptions, builtin_scene_sized, suite};
+use crate::synth::{GenerateOptions, cached_suite_scene, suite};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -54,8 +54,8 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
     let registries = pipeline::Registries::default();
     registries.check(&base).map_err(|e| crate::Error::Usage(format!("{}: {e}", args.config.display())))?;
     let device = crate::device::device(base.device)?;
-    let size = Some([args.size, args.size]);
-    let entries: Vec<_> = suite(&GenerateOptions { size, ..GenerateOptions::default() })?
+    let options = GenerateOptions { size: Some([args.size, args.size]), ..GenerateOptions::default() };
+    let entries: Vec<_> = suite(&options)?
         .into_iter()
         .filter(|e| args.bases.iter().any(|b| e.name.starts_with(&format!("{b}_"))))
         .filter(|e| {
@@ -69,7 +69,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
     println!("ablation: {} scenes x {} variants at {s}x{s} px", entries.len(), VARIANTS.len(), s = args.size);
     let mut rows = Vec::new();
     for entry in &entries {
-        let scene_dir = builtin_scene_sized(&entry.name, size)?;
+        let scene_dir = cached_suite_scene(entry, &options)?;
         let scene = Scene::load(&scene_dir)?;
         for (variant, init, motion) in VARIANTS {
             let mut config = base.clone();

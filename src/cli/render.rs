@@ -50,6 +50,7 @@ pub fn run(args: RenderArgs) -> crate::Result<()> {
             None => "no motion".into(),
         }
     );
+    // Checked again when writing; checked here too so that a refused run renders nothing.
     if args.out.exists() && !args.force {
         return Err(crate::Error::Usage(format!("{}: already exists (pass --force to replace it)", args.out.display())));
     }

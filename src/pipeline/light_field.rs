@@ -1,14 +1,13 @@
 //! Rendering a saved model's whole light field: every view of its grid, either as the scene was
 //! at t = 0 (the rolling shutter compensated) or as the camera captured it.
 
-use super::{params_tensor, static_shape};
+use super::{colour_raster, params_tensor, static_shape};
 use crate::config::MotionConfig;
-use crate::geometry::ViewId;
+use crate::geometry::{ViewGrid, ViewId, readout_interval};
 use crate::io::{MotionRecord, Raster};
 use crate::model::SavedModel;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
-use crate::render::{RenderOutput, RenderSettings, RsTiming, render_rolling_shutter, render_rows};
-use crate::geometry::{ViewGrid, readout_interval};
+use crate::render::{RenderSettings, RsTiming, render_rolling_shutter, render_rows};
 use burn::tensor::Device;
 
 /// Fixed-point iterations of the per-Gaussian read-out time when rendering as captured.
@@ -85,14 +84,10 @@ pub fn render_light_field(
                 }
             }
         };
-        out.push(colour_raster(rendered, w, h, c));
+        let mut image = colour_raster(rendered.colour, w, h, c);
+        image.data.iter_mut().for_each(|x| *x = x.clamp(0.0, 1.0));
+        out.push(image);
         progress(i + 1, views.len());
     }
     Ok(out)
-}
-
-/// The colour of a whole-view render as an image, clamped to [0, 1].
-fn colour_raster(out: RenderOutput, w: usize, h: usize, c: usize) -> Raster {
-    let data = out.colour.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
-    Raster { width: w, height: h, channels: c, data: data.into_iter().map(|x| x.clamp(0.0, 1.0)).collect() }
 }

@@ -106,13 +106,19 @@ pub fn rs_timing(config: &Config) -> RsTiming {
 /// `fallback`'s where the render is not opaque enough.
 fn central_rasters(out: RenderOutput, w: usize, h: usize, c: usize, fallback: &Raster) -> (Raster, Raster) {
     let data = |t: TensorData| t.convert::<f32>().try_to_vec::<f32>().expect("float data");
-    let colour = data(out.colour.into_data());
+    let colour = colour_raster(out.colour, w, h, c);
     let disparity = data(out.disparity.into_data());
     let alpha = data(out.alpha.into_data());
     let disparity = (0..w * h)
         .map(|i| if alpha[i] > TRUSTED_ALPHA { disparity[i] / alpha[i] } else { fallback.data[i] })
         .collect();
-    (Raster { width: w, height: h, channels: c, data: colour }, Raster { width: w, height: h, channels: 1, data: disparity })
+    (colour, Raster { width: w, height: h, channels: 1, data: disparity })
+}
+
+/// The `[P, C]` colour of a whole-view render as a `w x h` image with `c` channels.
+fn colour_raster(colour: Tensor<2>, w: usize, h: usize, c: usize) -> Raster {
+    let data = colour.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
+    Raster { width: w, height: h, channels: c, data }
 }
 
 /// Renders the central view of `g`: its colour, and its disparity where opaque enough

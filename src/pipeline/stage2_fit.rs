@@ -129,7 +129,7 @@ pub fn fit_stage2(
         None => Plan::new(motion_plan),
     };
     let stage = Stage { iterations: fit.iterations, plan };
-    let start = MotionAndScene { motion: MotionParams::new(start, &scales, device), gaussians: g };
+    let initial = MotionAndScene { motion: MotionParams::new(start, &scales, device), gaussians: g };
     let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
     let objective = |m: &MotionAndScene, _step: usize| {
         let params = m.motion.si(&scales);
@@ -154,6 +154,6 @@ pub fn fit_stage2(
         }
         loss.mean()
     };
-    let (fitted, curve) = optimise(start, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
+    let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
     MotionFit { parameters: fitted.motion.si_values(&scales), scales, curve, gaussians: fitted.gaussians }
 }

@@ -2,7 +2,7 @@
 //! generated into a cache folder the first time they are asked for.
 
 use super::scene_folder::{GenerateOptions, generate_with_progress};
-use super::suite::suite;
+use super::suite::{SuiteEntry, suite};
 use crate::io::{IoError, IoResult};
 use std::path::PathBuf;
 
@@ -32,11 +32,8 @@ pub fn builtin_scene(name: &str) -> IoResult<PathBuf> {
 /// generated when not yet in the cache. The suite's motions are set for 512 px and their pixel
 /// shifts scale with the width (a 64 px scene moves 1/8 as many pixels).
 pub fn builtin_scene_sized(name: &str, size: Option<[usize; 2]>) -> IoResult<PathBuf> {
-    let folder = match size {
-        Some([w, h]) => format!("{name}_{w}x{h}"),
-        None => name.to_string(),
-    };
-    let dir = cache_dir().join("scenes").join(folder);
+    // A cached scene is returned without building the suite.
+    let dir = cache_folder(name, size);
     if dir.join("parameters.cfg").exists() {
         return Ok(dir);
     }
@@ -46,8 +43,27 @@ pub fn builtin_scene_sized(name: &str, size: Option<[usize; 2]>) -> IoResult<Pat
         let names: Vec<&str> = entries.iter().map(|e| e.name.as_str()).collect();
         IoError::new(format!("{BUILTIN_PREFIX}{name}"), format!("no such built-in scene (expected one of {})", names.join(", ")))
     })?;
-    println!("generating built-in scene {name} into {} (once)", dir.display());
-    let scene = generate_with_progress(&entry.description, &options).map_err(|e| IoError::new(&dir, e))?;
+    cached_suite_scene(entry, &options)
+}
+
+/// The cache folder of suite entry `entry` generated under `options` (the entry must come from
+/// `suite(options)`), generated when not yet there.
+pub fn cached_suite_scene(entry: &SuiteEntry, options: &GenerateOptions) -> IoResult<PathBuf> {
+    let dir = cache_folder(&entry.name, options.size);
+    if dir.join("parameters.cfg").exists() {
+        return Ok(dir);
+    }
+    println!("generating built-in scene {} into {} (once)", entry.name, dir.display());
+    let scene = generate_with_progress(&entry.description, options).map_err(|e| IoError::new(&dir, e))?;
     scene.write(&dir, true)?;
     Ok(dir)
+}
+
+/// Where suite scene `name` at `size` is cached.
+fn cache_folder(name: &str, size: Option<[usize; 2]>) -> PathBuf {
+    let folder = match size {
+        Some([w, h]) => format!("{name}_{w}x{h}"),
+        None => name.to_string(),
+    };
+    cache_dir().join("scenes").join(folder)
 }

@@ -12,7 +12,7 @@ mod texture;
 mod truth;
 mod world;
 
-pub use builtin::{BUILTIN_PREFIX, builtin_scene, builtin_scene_sized, cache_dir};
+pub use builtin::{BUILTIN_PREFIX, builtin_scene, builtin_scene_sized, cache_dir, cached_suite_scene};
 pub use description::{CameraSettings, ObjectDescription, RenderSettings, SceneDescription};
 pub use render::Capture;
 pub use scene_folder::{GenerateOptions, GeneratedScene, capture_setup, generate, generate_with_progress};
