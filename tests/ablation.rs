@@ -19,7 +19,7 @@ fn the_ablation_prints_and_writes_the_four_row_table() {
     assert!(stdout.contains("ablation: 3 scenes x 4 variants at 32x32 px"), "{stdout}");
     let table = std::fs::read_to_string(out.join("ablation.md")).unwrap();
     assert!(stdout.contains(&table), "the printed table is the written one");
-    let rows: Vec<&str> = table.lines().skip(2).collect();
+    let rows: Vec<&str> = table.lines().skip(2).take(4).collect();
     let names: Vec<&str> = rows.iter().map(|r| r.split('|').nth(1).unwrap().trim()).collect();
     assert_eq!(names, ["no init, no motion", "no motion", "no init", "full"]);
     for row in &rows {
@@ -27,13 +27,24 @@ fn the_ablation_prints_and_writes_the_four_row_table() {
         assert_eq!(cells.len(), 6, "{row}");
         assert!(cells.iter().all(|v| v.is_finite() && *v >= 0.0), "{row}");
     }
+    // The second table: BadPix(0.07) for every variant, motion errors only where stage 2 ran.
+    let second: Vec<&str> = table.lines().skip(9).collect();
+    assert_eq!(second.len(), 4, "{table}");
+    for (row, name) in second.iter().zip(names) {
+        let cells: Vec<&str> = row.split('|').skip(2).map(str::trim).filter(|c| !c.is_empty()).collect();
+        assert_eq!(cells.len(), 8, "{row}");
+        assert!(cells[..3].iter().all(|c| c.parse::<f64>().is_ok_and(|v| (0.0..=100.0).contains(&v))), "{row}");
+        let with_motion = name == "no init" || name == "full";
+        assert!(cells[3..].iter().all(|c| c.parse::<f64>().is_ok() == with_motion), "{row}");
+    }
     let csv = std::fs::read_to_string(out.join("ablation.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 3 * 4, "{csv}");
     // Only the variants with stage 2 estimate a motion.
     for line in csv.lines().skip(1) {
         let fields: Vec<&str> = line.split(',').collect();
         let moving_variant = fields[2] == "no init" || fields[2] == "full";
-        assert_eq!(!fields[5].is_empty(), moving_variant, "{line}");
+        assert_eq!(!fields[6].is_empty(), moving_variant, "{line}");
+        assert_eq!(!fields[7].is_empty(), moving_variant, "{line}");
     }
     // The result folders are there for inspection.
     assert!(out.join("objects_static/full/central.png").exists());

@@ -61,6 +61,10 @@ fn each_motion_model_runs_by_config_and_writes_format_results() {
         let image = &metrics["motion"]["image"];
         assert!(image["rms_true_shift_px"].as_f64().unwrap() > 1.0, "{image}");
         assert!(image["rms_error_px"].as_f64().unwrap().is_finite(), "{image}");
+        // The cue is a few percent of the shift in every direction (4 d rows of a 64-row read-out).
+        let observability = &metrics["motion"]["observability"];
+        let ratios: Vec<f64> = observability["per_parameter"].as_array().unwrap().iter().map(|p| p[1].as_f64().unwrap()).collect();
+        assert!(ratios.len() == 6 && ratios.iter().all(|r| *r > 0.005 && *r < 0.5), "{observability}");
     }
 }
 

@@ -44,7 +44,9 @@ struct Row {
     variant: &'static str,
     rmse_intensity: f64,
     abs_diff_depth_m: f64,
+    badpix_007_percent: f64,
     motion_error_px: Option<f64>,
+    true_shift_px: Option<f64>,
     seconds: f64,
 }
 
@@ -87,32 +89,54 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
             let seconds = start.elapsed().as_secs_f64();
             let rmse_intensity = report.central_psnr_db.map_or(f64::NAN, |db| 10f64.powf(-db / 20.0));
             let abs_diff_depth_m = report.depth.as_ref().map_or(f64::NAN, |d| d.metrics.abs_diff_m);
-            let motion_error_px = report.motion.as_ref().and_then(|m| m.image.as_ref()).map(|i| i.rms_error_px);
+            let badpix_007_percent = report
+                .disparity
+                .as_ref()
+                .and_then(|d| d.badpix_percent.iter().find(|(t, _)| (*t - 0.07).abs() < 1e-9).map(|(_, p)| *p))
+                .unwrap_or(f64::NAN);
+            let image = report.motion.as_ref().and_then(|m| m.image.as_ref());
+            let (motion_error_px, true_shift_px) = (image.map(|i| i.rms_error_px), image.map(|i| i.rms_true_shift_px));
             println!(
-                "  {:24} {:20} rmse {:.4}  abs diff {:.4} m{}  ({:.0} s)",
+                "  {:24} {:20} rmse {:.4}  abs diff {:.4} m  BadPix(0.07) {:.1}%{}  ({:.0} s)",
                 entry.name,
                 variant,
                 rmse_intensity,
                 abs_diff_depth_m,
+                badpix_007_percent,
                 motion_error_px.map_or(String::new(), |e| format!("  motion {e:.2} px")),
                 seconds
             );
-            rows.push(Row { scene: entry.name.clone(), category: entry.category, variant, rmse_intensity, abs_diff_depth_m, motion_error_px, seconds });
+            rows.push(Row {
+                scene: entry.name.clone(),
+                category: entry.category,
+                variant,
+                rmse_intensity,
+                abs_diff_depth_m,
+                badpix_007_percent,
+                motion_error_px,
+                true_shift_px,
+                seconds,
+            });
         }
     }
     let table = table(&rows);
     println!("\n{table}");
-    let csv: String = std::iter::once("scene,category,variant,rmse_intensity,abs_diff_depth_m,motion_error_px,seconds\n".to_string())
-        .chain(rows.iter().map(|r| {
-            format!(
-                "{},{},{},{},{},{},{:.1}\n",
-                r.scene,
-                r.category,
-                r.variant.replace(", ", " & "),
-                r.rmse_intensity,
-                r.abs_diff_depth_m,
-                r.motion_error_px.map_or(String::new(), |e| e.to_string()),
-                r.seconds
+    let optional = |v: Option<f64>| v.map_or(String::new(), |e| e.to_string());
+    let csv: String = std::iter::once(
+        "scene,category,variant,rmse_intensity,abs_diff_depth_m,badpix_007_percent,motion_error_px,true_shift_px,seconds\n".to_string(),
+    )
+    .chain(rows.iter().map(|r| {
+        format!(
+            "{},{},{},{},{},{},{},{},{:.1}\n",
+            r.scene,
+            r.category,
+            r.variant.replace(", ", " & "),
+            r.rmse_intensity,
+            r.abs_diff_depth_m,
+            r.badpix_007_percent,
+            optional(r.motion_error_px),
+            optional(r.true_shift_px),
+            r.seconds
             )
         }))
         .collect();
@@ -122,12 +146,15 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
     Ok(())
 }
 
-/// The mean of each (variant, category) cell as a Markdown table, the paper's layout.
+/// The mean of each (variant, category) cell as Markdown: the paper's table (intensity RMSE and
+/// depth error), then disparity BadPix(0.07) and the image-space motion error (px, and as a
+/// share of the true rolling-shutter shift).
 fn table(rows: &[Row]) -> String {
-    let mean = |variant: &str, category: &str, value: &dyn Fn(&Row) -> f64| {
+    let mean_to = |digits: usize, variant: &str, category: &str, value: &dyn Fn(&Row) -> f64| {
         let v: Vec<f64> = rows.iter().filter(|r| r.variant == variant && r.category == category).map(value).filter(|x| x.is_finite()).collect();
-        if v.is_empty() { "n/a".to_string() } else { format!("{:.4}", v.iter().sum::<f64>() / v.len() as f64) }
+        if v.is_empty() { "n/a".to_string() } else { format!("{:.digits$}", v.iter().sum::<f64>() / v.len() as f64) }
     };
+    let mean = |variant: &str, category: &str, value: &dyn Fn(&Row) -> f64| mean_to(4, variant, category, value);
     let count = |category: &str| rows.iter().filter(|r| r.variant == VARIANTS[0].0 && r.category == category).count();
     let mut s = format!(
         "| | rmse (intensity) GS ({}) | slow ({}) | fast ({}) | abs diff (depth, m) GS | slow | fast |\n|---|---|---|---|---|---|---|\n",
@@ -140,6 +167,18 @@ fn table(rows: &[Row]) -> String {
             .iter()
             .map(|c| mean(variant, c, &|r| r.rmse_intensity))
             .chain(CATEGORIES.iter().map(|c| mean(variant, c, &|r| r.abs_diff_depth_m)))
+            .collect();
+        s += &format!("| {variant} | {} |\n", cells.join(" | "));
+    }
+    s += "\n| | BadPix(0.07) % GS | slow | fast | motion error (px) GS | slow | fast | (% of the true shift) slow | fast |\n|---|---|---|---|---|---|---|---|---|\n";
+    for (variant, _, _) in VARIANTS {
+        let px = |c: &str| mean_to(3, variant, c, &|r| r.motion_error_px.unwrap_or(f64::NAN));
+        let share = |c: &str| mean_to(1, variant, c, &|r| r.motion_error_px.zip(r.true_shift_px).map_or(f64::NAN, |(e, t)| 100.0 * e / t));
+        let cells: Vec<String> = CATEGORIES
+            .iter()
+            .map(|c| mean_to(1, variant, c, &|r| r.badpix_007_percent))
+            .chain(CATEGORIES.iter().map(|c| px(c)))
+            .chain(["slow", "fast"].iter().map(|c| share(c)))
             .collect();
         s += &format!("| {variant} | {} |\n", cells.join(" | "));
     }

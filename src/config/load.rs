@@ -168,7 +168,7 @@ mod tests {
         assert_eq!(c.stage1.gaussians, 20_000);
         assert_eq!(c.motion.model, "constant_velocity");
         let kinds: Vec<&str> = c.loss.iter().map(|l| l.kind.as_str()).collect();
-        assert_eq!(kinds, vec!["l1", "smoothness"]);
+        assert_eq!(kinds, vec!["l1", "smoothness", "motion_prior"]);
     }
 
     #[test]

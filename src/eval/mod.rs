@@ -2,6 +2,7 @@
 
 mod metrics;
 mod motion_error;
+mod observability;
 mod report;
 
 pub use metrics::{
@@ -9,10 +10,14 @@ pub use metrics::{
     evaluation_region, motion_parameter_errors, psnr_db,
 };
 pub use motion_error::{ImageMotionError, image_motion_error};
+pub use observability::{Observability, PARAMETER_NAMES, observability};
 pub use report::{DepthReport, EvalReport, MotionReport};
 
 /// `rslf eval` compares motions on every 4th ground-truth pixel each way.
 pub const MOTION_POINT_STRIDE: usize = 4;
+
+/// The observability analysis linearises on every 8th ground-truth pixel each way.
+pub const OBSERVABILITY_POINT_STRIDE: usize = 8;
 
 use crate::geometry::Camera;
 use crate::io::{GroundTruth, IoError, IoResult, MotionRecord, Raster, Scene, read_if_present, read_image, read_pfm};
@@ -106,6 +111,10 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
             parameters: motion_parameter_errors(e, t),
             image: match (&camera, &gt.depth) {
                 (Some(cam), Some(z)) => image_motion_error(cam, e, t, z, MOTION_POINT_STRIDE),
+                _ => None,
+            },
+            observability: match (&camera, &gt.depth) {
+                (Some(cam), Some(z)) => observability(cam, t, z, OBSERVABILITY_POINT_STRIDE),
                 _ => None,
             },
         }),

@@ -2,6 +2,7 @@
 
 use super::metrics::{DepthMetrics, DisparityMetrics, ParameterError};
 use super::motion_error::ImageMotionError;
+use super::observability::Observability;
 use crate::io::{IoError, IoResult, write_atomic};
 use serde::Serialize;
 use std::fmt;
@@ -30,6 +31,9 @@ pub struct MotionReport {
     pub parameters: Option<Vec<ParameterError>>,
     /// The image-space error, when the scene has a camera and ground-truth depth.
     pub image: Option<ImageMotionError>,
+    /// How strongly the scene's cue observes each direction of constant-velocity motion, when
+    /// the scene has a camera and ground-truth depth.
+    pub observability: Option<Observability>,
 }
 
 /// Everything `rslf eval` measured. Non-finite numbers are written as `null`.
@@ -103,6 +107,13 @@ impl fmt::Display for EvalReport {
                     }
                 }
                 None => writeln!(f, "motion     estimated `{}` vs true `{}`: parameters not comparable", m.estimated_model, m.true_model)?,
+            }
+            if let Some(o) = &m.observability {
+                let per: Vec<String> = o.per_parameter.iter().map(|(n, r)| format!("{n} {}", num(*r, 4))).collect();
+                writeln!(f, "motion     observability, px of cue per px of image-space effect: {}", per.join("  "))?;
+                let dirs: Vec<String> =
+                    o.directions.iter().take(3).map(|(r, d)| format!("{} ({})", num(*r, 4), Observability::describe(d))).collect();
+                writeln!(f, "motion     weakest directions: {}", dirs.join(", "))?;
             }
         }
         for note in &self.notes {

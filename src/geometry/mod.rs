@@ -11,4 +11,4 @@ pub use camera::{Camera, ViewGrid, ViewId};
 pub use rigid_motion::{Pose, pose_at, readout_interval};
 pub use rs_projection::rs_project;
 pub use lift::TensorCamera;
-pub use rotation::{PoseBatch, rotate, rotate_inverse, rotation_matrices};
+pub use rotation::{PoseBatch, compose, rotate, rotate_inverse, rotation_matrices};

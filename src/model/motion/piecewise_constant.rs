@@ -4,7 +4,7 @@
 //! [`crate::geometry::pose_at`]; the first and last segments extend beyond the interval.
 
 use super::{MotionModel, ParamKind, scale_rows, three, vec3};
-use crate::geometry::{PoseBatch, rotation_matrices};
+use crate::geometry::{PoseBatch, compose, rotation_matrices};
 use crate::io::MotionRecord;
 use burn::tensor::Tensor;
 
@@ -41,36 +41,35 @@ impl MotionModel for PiecewiseConstant {
     }
 
     fn poses(&self, params: Tensor<1>, times: Tensor<1>) -> PoseBatch {
-        // Signed time spent in each segment going from 0 to t: forward (t > 0) or back (t < 0).
+        // Time spent in each segment going from 0 to t, forward (t > 0) or back (t < 0); at most
+        // one of the two is non-zero for a given t.
         let forward = |lo: f64, hi: f64| (times.clone().clamp_max(hi) - lo.max(0.0)).clamp_min(0.0);
-        let back = |lo: f64, hi: f64| (times.clone().clamp_min(lo).neg() + hi.min(0.0)).clamp_min(0.0).neg();
-        let mut rotation_forward: Option<Tensor<3>> = None;
-        let mut rotation_back: Option<Tensor<3>> = None;
+        let back = |lo: f64, hi: f64| (times.clone().clamp_min(lo).neg() + hi.min(0.0)).clamp_min(0.0);
+        // Going forward the rotation is `A_{K-1} ⋯ A_0` with `A_j = R(Δ_j ω_j)`, later segments
+        // acting last; going back it is `R(-Δ_0 ω_0) ⋯ R(-Δ_{K-1} ω_{K-1})`, the transpose of
+        // the same product. One product serves both: K rotations instead of 2K.
+        let mut product: Option<Tensor<3>> = None;
         let mut translation: Option<Tensor<2>> = None;
         for j in 0..self.segments {
             let (lo, hi) = self.span(j);
             let (dt_f, dt_b) = (forward(lo, hi), back(lo, hi));
             let (omega, velocity) = (vec3(&params, 6 * j), vec3(&params, 6 * j + 3));
-            // Going forward, later segments act last (left); going back, earlier segments do.
-            let rf = rotation_matrices(scale_rows(&dt_f, omega.clone()));
-            let rb = rotation_matrices(scale_rows(&dt_b, omega));
-            rotation_forward = Some(match rotation_forward {
-                Some(r) => rf.matmul(r),
-                None => rf,
+            let a = rotation_matrices(scale_rows(&(dt_f.clone() + dt_b.clone()), omega));
+            product = Some(match product {
+                Some(p) => compose(a, p),
+                None => a,
             });
-            rotation_back = Some(match rotation_back {
-                Some(r) => r.matmul(rb),
-                None => rb,
-            });
-            let step = scale_rows(&(dt_f + dt_b), velocity);
+            let step = scale_rows(&(dt_f - dt_b), velocity);
             translation = Some(match translation {
                 Some(t) => t + step,
                 None => step,
             });
         }
-        let (rf, rb, t) = (rotation_forward.expect("K ≥ 1"), rotation_back.expect("K ≥ 1"), translation.expect("K ≥ 1"));
-        // For each time one of the two products is the identity.
-        PoseBatch { rotation: rf.matmul(rb), translation: t }
+        let (product, translation) = (product.expect("K ≥ 1"), translation.expect("K ≥ 1"));
+        let n = times.dims()[0];
+        let backwards = times.lower_elem(0.0).reshape([n, 1, 1]).expand([n, 3, 3]);
+        let rotation = product.clone().mask_where(backwards, product.swap_dims(1, 2));
+        PoseBatch { rotation, translation }
     }
 
     fn record(&self, p: &[f64]) -> MotionRecord {
