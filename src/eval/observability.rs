@@ -11,6 +11,7 @@
 
 use crate::geometry::{Camera, ViewId, rs_project};
 use crate::io::{MotionRecord, Raster};
+use crate::model::motion::{ConstantVelocity, MotionModel};
 use nalgebra::{SMatrix, SVector};
 use serde::Serialize;
 
@@ -31,21 +32,10 @@ pub struct Observability {
     pub directions: Vec<(f64, [f64; 6])>,
 }
 
-fn parameters(m: &MotionRecord) -> [f64; 6] {
-    match m {
-        MotionRecord::ConstantVelocity { omega_rad_s: w, velocity_m_s: v } => [w[0], w[1], w[2], v[0], v[1], v[2]],
-        _ => [0.0; 6],
-    }
-}
-
-fn record(p: &[f64; 6]) -> MotionRecord {
-    MotionRecord::ConstantVelocity { omega_rad_s: [p[0], p[1], p[2]], velocity_m_s: [p[3], p[4], p[5]] }
-}
-
 /// Where `p0` lands in each of `views` under the motion `theta`.
-fn images<const N: usize>(camera: &Camera, theta: &[f64; 6], views: &[ViewId; N], p0: &nalgebra::Point3<f64>) -> Option<[(f64, f64); N]> {
-    let m = record(theta);
-    let mut out = [(0.0, 0.0); N];
+fn images(camera: &Camera, theta: &[f64; 6], views: &[ViewId; 6], p0: &nalgebra::Point3<f64>) -> Option<[(f64, f64); 6]> {
+    let m = ConstantVelocity.record(theta);
+    let mut out = [(0.0, 0.0); 6];
     for (o, &view) in out.iter_mut().zip(views) {
         let (x, y, _) = rs_project(camera, &m, view, p0)?;
         *o = (x, y);
@@ -87,7 +77,7 @@ pub fn observability(camera: &Camera, truth: &MotionRecord, gt_depth: &Raster, s
     let neighbour = ViewId { col: centre.col + 1, ..centre };
     let c = camera.grid.corners();
     let views = [centre, neighbour, c[0], c[1], c[2], c[3]];
-    let at = parameters(truth);
+    let at: [f64; 6] = ConstantVelocity.parameters_of(truth).and_then(|p| p.try_into().ok()).unwrap_or([0.0; 6]);
     // Gram matrices of the cue (corner positions minus the central row's predictions, 8 rows
     // per point) and of the image-space effect (all five positions, 10 rows per point), over
     // the parameters, from central differences.
