@@ -88,3 +88,39 @@ fn eval_of_antinous_ground_truth_against_itself_is_perfect() {
     }
     assert!(json["depth"].is_null(), "antinous has no parameters.cfg: no depth");
 }
+
+/// Reads the central view where the central-view disparity at a corner pixel says that pixel
+/// came from; the mean colour error at the pixels `explained_mask` keeps and at those it leaves out.
+fn backward_warp_errors(scene: &Scene, gt: &rslf::io::Raster, view: ViewId, mask: &rslf::io::Raster) -> (f64, f64) {
+    let (central, img) = (scene.central(), scene.view(view).unwrap());
+    let (dx, dy) = scene.grid.offset(view);
+    let mut sums = [(0.0f64, 0usize); 2];
+    for y in 0..img.height {
+        for x in 0..img.width {
+            let d = gt.get(x, y, 0) as f64;
+            let (xs, ys) = (x as f64 + dx * d, y as f64 + dy * d);
+            for ch in 0..img.channels {
+                if let Some(s) = central.sample_bilinear(xs as f32, ys as f32, ch) {
+                    let slot = &mut sums[(mask.get(x, y, 0) == 1.0) as usize];
+                    slot.0 += (s - img.get(x, y, ch)).abs() as f64;
+                    slot.1 += 1;
+                }
+            }
+        }
+    }
+    (sums[1].0 / sums[1].1 as f64, sums[0].0 / sums[0].1.max(1) as f64)
+}
+
+#[test]
+fn the_disocclusion_mask_of_antinous_corners_leaves_out_what_the_central_view_does_not_see() {
+    let dir = hci("antinous");
+    let scene = Scene::load(&dir).unwrap();
+    let gt = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
+    for view in scene.grid.corners() {
+        let mask = rslf::pipeline::explained_mask(&gt, scene.grid.offset(view), 1);
+        let kept = mask.data.iter().sum::<f32>() / mask.data.len() as f32;
+        assert!((0.9..0.999).contains(&kept), "view {view:?}: {kept} kept");
+        let (kept_error, left_out_error) = backward_warp_errors(&scene, &gt, view, &mask);
+        assert!(left_out_error > 8.0 * kept_error, "view {view:?}: error {kept_error} kept vs {left_out_error} left out");
+    }
+}

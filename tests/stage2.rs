@@ -45,8 +45,17 @@ fn each_motion_model_runs_by_config_and_writes_format_results() {
     let root = common::tempdir();
     generate(root.path());
     for model in ["constant_velocity", "constant_acceleration", "piecewise_constant"] {
-        let stdout = train(root.path(), &config(root.path(), model, model, "iterations = 10"), model);
+        // One run also masks the disocclusions: it says how much of the views it compared.
+        let masked = model == "constant_acceleration";
+        let extra = if masked { "iterations = 10\nmask_disocclusions = true" } else { "iterations = 10" };
+        let stdout = train(root.path(), &config(root.path(), model, model, extra), model);
         assert!(stdout.contains(&format!("stage 2 fit: `{model}` motion")), "{stdout}");
+        if masked {
+            let share: f64 = stdout.split("% of the pixels compared (disocclusions masked)").next().unwrap().rsplit(' ').next().unwrap().parse().unwrap();
+            assert!((80.0..100.0).contains(&share), "{share}% compared: {stdout}");
+        } else {
+            assert!(stdout.contains("every pixel compared"), "{stdout}");
+        }
         let out = root.path().join(model);
         let motion = MotionRecord::read(&out.join("motion.toml")).unwrap();
         assert_eq!(motion.model_name(), model);

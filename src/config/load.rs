@@ -135,6 +135,9 @@ impl Config {
         if self.stage2.band_height == 0 {
             return fail("stage2.band_height", "must be at least 1 row");
         }
+        if self.stage2.disocclusion_margin > 32 {
+            return fail("stage2.disocclusion_margin", "must be at most 32 pixels");
+        }
         if self.motion.model.is_empty() {
             return fail("motion.model", "must name a motion model");
         }
@@ -194,5 +197,7 @@ mod tests {
     fn ranges_are_checked() {
         let err = parse("[[loss]]\nkind = \"l1\"\nweight = -1.0\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("loss[0].weight"));
+        let err = parse("[stage2]\ndisocclusion_margin = 1000\n").unwrap_err();
+        assert_eq!(err.key.as_deref(), Some("stage2.disocclusion_margin"));
     }
 }

@@ -152,6 +152,12 @@ pub struct Stage2Config {
     /// the off-row views together, at the stage-1 rates times this factor (0 = motion only, the
     /// paper's stage 2).
     pub refine_gaussians: f64,
+    /// Leave out of the photometric terms the pixels of each compared view that no central-view
+    /// pixel reaches (surfaces the central view does not see, which the Gaussians cannot
+    /// render), so that the motion is not bent to shrink their residuals.
+    pub mask_disocclusions: bool,
+    /// Pixels by which that mask is widened around each pixel no central-view pixel reaches.
+    pub disocclusion_margin: usize,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
     pub initial_motion: Option<PathBuf>,
@@ -170,6 +176,8 @@ impl Default for Stage2Config {
             lr_final: 0.01,
             adam_epsilon: 1e-8,
             refine_gaussians: 1.0,
+            mask_disocclusions: false,
+            disocclusion_margin: 2,
             initial_motion: None,
         }
     }

@@ -8,6 +8,7 @@ mod results;
 mod stage1_fit;
 mod stage2_fit;
 mod targets;
+mod visibility;
 
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
@@ -15,6 +16,7 @@ pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{PointCloud, RunResult, depth_map};
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
 pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales};
+pub use visibility::explained_mask;
 
 use crate::config::{Config, TimingChoice, ViewSelection};
 use crate::geometry::{Camera, TensorCamera, ViewId, readout_interval};
@@ -198,7 +200,10 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
                 })?,
                 None => vec![0.0; model.parameters().len()],
             };
-            let fitted = stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &losses, device, &mut log);
+            // The stage-1 geometry, where the masks of what the Gaussians cannot show come from.
+            let (_, stage1_disparity) = render_central(&gaussians, scene, &render, &initial, device);
+            let fitted =
+                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &losses, device, &stage1_disparity, &mut log);
             let gaussians = fitted.gaussians.clone();
             let (central, disparity, shape) =
                 render_compensated_central(&gaussians, scene, cam, model.as_ref(), &fitted.parameters, &render, &initial, device);
@@ -307,6 +312,7 @@ fn stage2(
     start_values: &[f64],
     losses: &WeightedLosses,
     device: &Device,
+    stage1_disparity: &Raster,
     log: &mut RunLog,
 ) -> MotionFit {
     let s = &config.stage2;
@@ -328,22 +334,28 @@ fn stage2(
         seed: config.seed,
         render: render_settings(config),
         refine,
+        disocclusion_margin: s.mask_disocclusions.then_some(s.disocclusion_margin),
     };
     let bar = crate::progress::bar(s.iterations as u64, "stage 2: motion");
     let start = Instant::now();
-    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, |done, _, loss| {
+    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, Some(stage1_disparity), |done, _, loss| {
         bar.set_position(done as u64);
         bar.set_message(format!("stage 2: loss {loss:.4}"));
     });
     bar.finish_and_clear();
     log.lines.push(format!(
-        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), loss {:.4} -> {:.4}, {:.1} s",
+        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}, loss {:.4} -> {:.4}, {:.1} s",
         model.name(),
         s.iterations,
         s.bands_per_step,
         s.band_height,
         views.len(),
         s.timing,
+        if fit.disocclusion_margin.is_some() {
+            format!("{:.1}% of the pixels compared (disocclusions masked)", 100.0 * fitted.kept)
+        } else {
+            "every pixel compared".to_string()
+        },
         fitted.curve.first().copied().unwrap_or(f32::NAN),
         fitted.curve.last().copied().unwrap_or(f32::NAN),
         start.elapsed().as_secs_f64()

@@ -3,8 +3,9 @@
 //! rolling shutter into each view and compares a stratified sample of row bands.
 
 use super::targets::{band_tensor, view_targets};
+use super::visibility::{explained_mask, masked};
 use crate::geometry::{Camera, TensorCamera, ViewId};
-use crate::io::Scene;
+use crate::io::{Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
 use super::stage1_fit::{LearningRates, with_gaussian_groups};
 use crate::model::Gaussians;
@@ -40,6 +41,9 @@ pub struct Stage2Fit {
     /// Joint refinement: when set, the Gaussians are fitted too, at these rates (Adam's epsilon
     /// as in stage 1), against the same views.
     pub refine: Option<(LearningRates, f32)>,
+    /// When set, the pixels of each view that no pixel of the central view reaches, widened by
+    /// this many pixels, are left out of the loss (see [`explained_mask`]).
+    pub disocclusion_margin: Option<usize>,
 }
 
 /// What the fit found.
@@ -53,6 +57,8 @@ pub struct MotionFit {
     pub curve: Vec<f32>,
     /// The Gaussians: refined with joint refinement, else as given.
     pub gaussians: Gaussians,
+    /// The share of the compared views' pixels left in the loss (1 without masks).
+    pub kept: f64,
 }
 
 /// What stage 2 optimises: the scaled motion parameters and the Gaussians (frozen unless the
@@ -96,8 +102,10 @@ fn stratified(total: usize, count: usize, rng: &mut Rng) -> Vec<usize> {
 }
 
 /// Fits `model`'s parameters, starting from `start` (SI), to `views` of `scene`; the Gaussians
-/// `g` are held fixed unless `fit.refine` is set. `progress(step, total, loss)` is called after
-/// each step.
+/// `g` are held fixed unless `fit.refine` is set. With `fit.disocclusion_margin` set, the
+/// disocclusion masks are derived from `central_disparity` (the central view's disparity, e.g.
+/// the stage-1 render); without a map no pixel is masked. `progress(step, total, loss)` is
+/// called after each step.
 #[allow(clippy::too_many_arguments)]
 pub fn fit_stage2(
     g: Gaussians,
@@ -109,6 +117,7 @@ pub fn fit_stage2(
     fit: &Stage2Fit,
     losses: &WeightedLosses,
     device: &Device,
+    central_disparity: Option<&Raster>,
     mut progress: impl FnMut(usize, usize, f32),
 ) -> MotionFit {
     let g = if fit.refine.is_some() { g } else { g.no_grad() };
@@ -120,6 +129,16 @@ pub fn fit_stage2(
     // Band targets are cut once: `[P, C]` per (view, band).
     let band_targets: Vec<Vec<Tensor<2>>> =
         targets.iter().map(|(_, img)| all_bands.iter().map(|(rows, _)| band_tensor(img, rows.clone(), device)).collect()).collect();
+    // Disocclusion masks, cut like the targets: `[P, 1]` per (view, band).
+    let masks: Option<Vec<Raster>> = fit
+        .disocclusion_margin
+        .zip(central_disparity)
+        .map(|(margin, disparity)| targets.iter().map(|((dx, dy), _)| explained_mask(disparity, (*dx as f64, *dy as f64), margin)).collect());
+    let kept = masks.as_ref().map_or(1.0, |m| {
+        m.iter().map(|r| r.data.iter().map(|&x| x as f64).sum::<f64>()).sum::<f64>() / m.iter().map(|r| r.data.len() as f64).sum::<f64>()
+    });
+    let band_masks: Option<Vec<Vec<Tensor<2>>>> = masks
+        .map(|m| m.iter().map(|mask| all_bands.iter().map(|(rows, _)| band_tensor(mask, rows.clone(), device)).collect()).collect());
     let motion_plan = GroupPlan {
         schedule: Schedule::Cosine { start: fit.lr, end: fit.lr_final, steps: fit.iterations },
         adam_epsilon: fit.adam_epsilon,
@@ -136,7 +155,7 @@ pub fn fit_stage2(
         let shape = StaticShape::new(&m.gaussians, tc, model, params.clone());
         let scaled = m.motion.scaled.val();
         let mut loss = MeanLoss::default();
-        for ((offset, _), view_bands) in targets.iter().zip(&band_targets) {
+        for (v, ((offset, _), view_bands)) in targets.iter().zip(&band_targets).enumerate() {
             let rolling = match fit.timing {
                 RsTiming::PerGaussian(iterations) => Some(shape.splats_rolling(model, params.clone(), *offset, iterations)),
                 RsTiming::Bands(_) => None,
@@ -148,12 +167,16 @@ pub fn fit_stage2(
                     None => shape.splats_at_time(model, params.clone(), *offset, tau.expect("bands have a time")),
                 };
                 let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
-                let input = LossInput { rendered: &out, target: &view_bands[b], rows: rows.len(), width: w, motion: Some(&scaled) };
+                let (out, target) = match &band_masks {
+                    Some(masks) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
+                    None => (out, view_bands[b].clone()),
+                };
+                let input = LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion: Some(&scaled) };
                 loss.add(losses.evaluate(&input));
             }
         }
         loss.mean()
     };
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
-    MotionFit { parameters: fitted.motion.si_values(&scales), scales, curve, gaussians: fitted.gaussians }
+    MotionFit { parameters: fitted.motion.si_values(&scales), scales, curve, gaussians: fitted.gaussians, kept }
 }
