@@ -200,10 +200,11 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
                 })?,
                 None => vec![0.0; model.parameters().len()],
             };
-            // The stage-1 geometry, where the masks of what the Gaussians cannot show come from.
-            let (_, stage1_disparity) = render_central(&gaussians, scene, &render, &initial, device);
+            // The stage-1 geometry the disocclusion masks come from, rendered only when they are asked for.
+            let stage1_disparity =
+                config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
             let fitted =
-                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &losses, device, &stage1_disparity, &mut log);
+                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &losses, device, stage1_disparity.as_ref(), &mut log);
             let gaussians = fitted.gaussians.clone();
             let (central, disparity, shape) =
                 render_compensated_central(&gaussians, scene, cam, model.as_ref(), &fitted.parameters, &render, &initial, device);
@@ -312,7 +313,7 @@ fn stage2(
     start_values: &[f64],
     losses: &WeightedLosses,
     device: &Device,
-    stage1_disparity: &Raster,
+    stage1_disparity: Option<&Raster>,
     log: &mut RunLog,
 ) -> MotionFit {
     let s = &config.stage2;
@@ -338,7 +339,7 @@ fn stage2(
     };
     let bar = crate::progress::bar(s.iterations as u64, "stage 2: motion");
     let start = Instant::now();
-    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, Some(stage1_disparity), |done, _, loss| {
+    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, stage1_disparity, |done, _, loss| {
         bar.set_position(done as u64);
         bar.set_message(format!("stage 2: loss {loss:.4}"));
     });

@@ -135,7 +135,8 @@ pub fn fit_stage2(
         .zip(central_disparity)
         .map(|(margin, disparity)| targets.iter().map(|((dx, dy), _)| explained_mask(disparity, (*dx as f64, *dy as f64), margin)).collect());
     let kept = masks.as_ref().map_or(1.0, |m| {
-        m.iter().map(|r| r.data.iter().map(|&x| x as f64).sum::<f64>()).sum::<f64>() / m.iter().map(|r| r.data.len() as f64).sum::<f64>()
+        let values = m.iter().flat_map(|r| &r.data);
+        values.clone().map(|&x| x as f64).sum::<f64>() / values.count() as f64
     });
     let band_masks: Option<Vec<Vec<Tensor<2>>>> = masks
         .map(|m| m.iter().map(|mask| all_bands.iter().map(|(rows, _)| band_tensor(mask, rows.clone(), device)).collect()).collect());
