@@ -3,9 +3,9 @@
 //! rolling shutter into each view and compares a stratified sample of row bands.
 
 use super::targets::{band_tensor, view_targets};
-use super::visibility::{explained_mask, masked};
+use super::visibility::{explained_mask_moving, masked};
 use crate::geometry::{Camera, TensorCamera, ViewId};
-use crate::io::{Raster, Scene};
+use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
 use super::stage1_fit::{LearningRates, with_gaussian_groups};
 use crate::model::Gaussians;
@@ -42,9 +42,12 @@ pub struct Stage2Fit {
     /// as in stage 1), against the same views.
     pub refine: Option<(LearningRates, f32)>,
     /// When set, the pixels of each view that no pixel of the central view reaches, widened by
-    /// this many pixels, are left out of the loss (see [`explained_mask`]).
+    /// this many pixels, are left out of the loss (see [`explained_mask_moving`]).
     pub disocclusion_margin: Option<usize>,
 }
+
+/// Steps between two redrawings of the disocclusion masks from the current motion.
+const MASK_REFRESH: usize = 10;
 
 /// What the fit found.
 #[derive(Debug, Clone)]
@@ -104,7 +107,7 @@ fn stratified(total: usize, count: usize, rng: &mut Rng) -> Vec<usize> {
 /// Fits `model`'s parameters, starting from `start` (SI), to `views` of `scene`; the Gaussians
 /// `g` are held fixed unless `fit.refine` is set. With `fit.disocclusion_margin` set, the
 /// disocclusion masks are derived from `central_disparity` (the central view's disparity, e.g.
-/// the stage-1 render); without a map no pixel is masked. `progress(step, total, loss)` is
+/// the stage-1 render) and the current motion estimate; without a map no pixel is masked. `progress(step, total, loss)` is
 /// called after each step.
 #[allow(clippy::too_many_arguments)]
 pub fn fit_stage2(
@@ -129,17 +132,18 @@ pub fn fit_stage2(
     // Band targets are cut once: `[P, C]` per (view, band).
     let band_targets: Vec<Vec<Tensor<2>>> =
         targets.iter().map(|(_, img)| all_bands.iter().map(|(rows, _)| band_tensor(img, rows.clone(), device)).collect()).collect();
-    // Disocclusion masks, cut like the targets: `[P, 1]` per (view, band).
-    let masks: Option<Vec<Raster>> = fit
-        .disocclusion_margin
-        .zip(central_disparity)
-        .map(|(margin, disparity)| targets.iter().map(|((dx, dy), _)| explained_mask(disparity, (*dx as f64, *dy as f64), margin)).collect());
-    let kept = masks.as_ref().map_or(1.0, |m| {
-        let values = m.iter().flat_map(|r| &r.data);
-        values.clone().map(|&x| x as f64).sum::<f64>() / values.count() as f64
-    });
-    let band_masks: Option<Vec<Vec<Tensor<2>>>> = masks
-        .map(|m| m.iter().map(|mask| all_bands.iter().map(|(rows, _)| band_tensor(mask, rows.clone(), device)).collect()).collect());
+    // Disocclusion masks, cut like the targets: `[P, 1]` per (view, band). They follow the
+    // motion: redrawn from the current estimate every `MASK_REFRESH` steps.
+    let present: Vec<ViewId> = views.iter().copied().filter(|&v| scene.view(v).is_some()).collect();
+    let draw_masks = |motion: &MotionRecord| -> Option<(f64, Vec<Vec<Tensor<2>>>)> {
+        let (margin, disparity) = fit.disocclusion_margin.zip(central_disparity)?;
+        let maps: Vec<Raster> = present.iter().map(|&view| explained_mask_moving(disparity, camera, view, motion, margin)).collect();
+        let values = maps.iter().flat_map(|r| &r.data);
+        let kept = values.clone().map(|&x| x as f64).sum::<f64>() / values.count().max(1) as f64;
+        let cut = maps.iter().map(|mask| all_bands.iter().map(|(rows, _)| band_tensor(mask, rows.clone(), device)).collect()).collect();
+        Some((kept, cut))
+    };
+    let mut masks = draw_masks(&model.record(start));
     let motion_plan = GroupPlan {
         schedule: Schedule::Cosine { start: fit.lr, end: fit.lr_final, steps: fit.iterations },
         adam_epsilon: fit.adam_epsilon,
@@ -151,7 +155,10 @@ pub fn fit_stage2(
     let stage = Stage { iterations: fit.iterations, plan };
     let initial = MotionAndScene { motion: MotionParams::new(start, &scales, device), gaussians: g };
     let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
-    let objective = |m: &MotionAndScene, _step: usize| {
+    let objective = |m: &MotionAndScene, step: usize| {
+        if masks.is_some() && step > 0 && step % MASK_REFRESH == 0 {
+            masks = draw_masks(&model.record(&m.motion.si_values(&scales)));
+        }
         let params = m.motion.si(&scales);
         let shape = StaticShape::new(&m.gaussians, tc, model, params.clone());
         let scaled = m.motion.scaled.val();
@@ -168,8 +175,8 @@ pub fn fit_stage2(
                     None => shape.splats_at_time(model, params.clone(), *offset, tau.expect("bands have a time")),
                 };
                 let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
-                let (out, target) = match &band_masks {
-                    Some(masks) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
+                let (out, target) = match &masks {
+                    Some((_, masks)) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
                     None => (out, view_bands[b].clone()),
                 };
                 let input = LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion: Some(&scaled) };
@@ -179,5 +186,6 @@ pub fn fit_stage2(
         loss.mean()
     };
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
+    let kept = masks.map_or(1.0, |(kept, _)| kept);
     MotionFit { parameters: fitted.motion.si_values(&scales), scales, curve, gaussians: fitted.gaussians, kept }
 }

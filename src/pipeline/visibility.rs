@@ -3,25 +3,47 @@
 //! the image border) the Gaussians, sampled on the central view, hold nothing to render, and a
 //! fit would bend the motion to shrink those residuals.
 
-use crate::io::Raster;
+use crate::geometry::{Camera, ViewId, pose_at, readout_interval, rs_project};
+use crate::io::{MotionRecord, Raster};
 use crate::render::RenderOutput;
 use burn::tensor::Tensor;
 
-/// A `0/1` mask of the view at `offset = (c - cc, r - rc)`: 1 where some central-view pixel of
-/// `disparity` lands (forward warp to `(x - dx d, y - dy d)`, onto the pixels around the landing
-/// point: its floor and ceiling in each axis), 0 at the pixels no central pixel reaches and
-/// within `margin` pixels of one.
+/// A `0/1` mask of the view at `offset = (c - cc, r - rc)` of a capture without motion: 1 where
+/// some central-view pixel of `disparity` lands (forward warp to `(x - dx d, y - dy d)`, onto the
+/// pixels around the landing point: its floor and ceiling in each axis), 0 at the pixels no
+/// central pixel reaches and within `margin` pixels of one.
 pub fn explained_mask(disparity: &Raster, offset: (f64, f64), margin: usize) -> Raster {
-    let (w, h) = (disparity.width, disparity.height);
     let (dx, dy) = offset;
+    mask_of_landings(disparity, margin, |x, y, d| Some((x - dx * d, y - dy * d)))
+}
+
+/// As [`explained_mask`], for `view` of a rolling-shutter capture under `motion`: each central
+/// pixel, seen at the read-out time of its row, is lifted with its disparity, moved back to
+/// t = 0 and re-imaged into `view` at the read-out time of the row it lands on. Where the motion
+/// shears the scene the uncovered background moves with it; without motion this is
+/// [`explained_mask`].
+pub fn explained_mask_moving(disparity: &Raster, camera: &Camera, view: ViewId, motion: &MotionRecord, margin: usize) -> Raster {
+    let readout = readout_interval(camera.height, camera.line_time_s);
+    mask_of_landings(disparity, margin, |x, y, d| {
+        let z = camera.disparity_to_depth(d);
+        if !(z.is_finite() && z > 0.0) {
+            return None;
+        }
+        let observed = camera.back_project(x, y, z);
+        let at_zero = pose_at(motion, camera.row_time(y), readout).inverse().apply(&observed);
+        rs_project(camera, motion, view, &at_zero).map(|(u, v, _)| (u, v))
+    })
+}
+
+/// The mask of the pixels around where `landing(x, y, d)` puts each central pixel `(x, y)` of
+/// disparity `d` (finite), with the unreached pixels widened by `margin`.
+fn mask_of_landings(disparity: &Raster, margin: usize, landing: impl Fn(f64, f64, f64) -> Option<(f64, f64)>) -> Raster {
+    let (w, h) = (disparity.width, disparity.height);
     let mut reached = vec![false; w * h];
     for y in 0..h {
         for x in 0..w {
             let d = disparity.data[(y * w + x) * disparity.channels] as f64;
-            if !d.is_finite() {
-                continue;
-            }
-            let (px, py) = (x as f64 - dx * d, y as f64 - dy * d);
+            let Some((px, py)) = d.is_finite().then(|| landing(x as f64, y as f64, d)).flatten() else { continue };
             for (xi, yi) in [(px.floor(), py.floor()), (px.ceil(), py.floor()), (px.floor(), py.ceil()), (px.ceil(), py.ceil())] {
                 if xi >= 0.0 && yi >= 0.0 && (xi as usize) < w && (yi as usize) < h {
                     reached[yi as usize * w + xi as usize] = true;
@@ -64,6 +86,42 @@ mod tests {
 
     fn left_out(mask: &Raster) -> usize {
         mask.data.iter().filter(|&&m| m == 0.0).count()
+    }
+
+    fn camera() -> Camera {
+        // b f = 2 px m: disparity 1 is a depth of 1.2 m; a row is read every millisecond.
+        let grid = crate::geometry::ViewGrid { rows: 9, cols: 9 };
+        Camera { grid, width: 40, height: 30, f_px: 100.0, baseline_m: 0.02, focus_m: 3.0, line_time_s: 1e-3 }
+    }
+
+    #[test]
+    fn without_motion_the_moving_mask_is_the_static_one() {
+        let cam = camera();
+        let disparity = map(40, 30, |x, y| if (10..22).contains(&x) && (8..20).contains(&y) { 1.3 } else { 0.1 + 0.01 * x as f32 });
+        let view = ViewId { row: 8, col: 1 };
+        let (dx, dy) = cam.grid.offset(view);
+        let moving = explained_mask_moving(&disparity, &cam, view, &MotionRecord::zero(), 1);
+        let fixed = explained_mask(&disparity, (dx, dy), 1);
+        assert!(left_out(&fixed) > 100, "the test map must uncover something");
+        assert_eq!(moving.data, fixed.data);
+    }
+
+    #[test]
+    fn a_sideways_motion_opens_a_strip_on_the_side_the_later_rows_slide_away_from() {
+        // A plane of disparity 0.9, seen from the top-centre view (dy = -4): each point lands
+        // 3.6 rows lower, read 3.6 ms later, by which time a velocity v along x has carried it
+        // f v 3.6 ms / z to the right: 3.5 px for the v set here. Rows 0-2 and columns 0-2 are
+        // left uncovered.
+        let cam = camera();
+        let disparity = map(40, 30, |_, _| 0.9);
+        let v = 3.5 * cam.disparity_to_depth(0.9) / (cam.f_px * 3.6 * cam.line_time_s);
+        let motion = MotionRecord::ConstantVelocity { omega_rad_s: [0.0; 3], velocity_m_s: [v, 0.0, 0.0] };
+        let mask = explained_mask_moving(&disparity, &cam, ViewId { row: 0, col: 4 }, &motion, 0);
+        for y in 0..30 {
+            let row = &mask.data[y * 40..(y + 1) * 40];
+            let expected = |x: usize| if y < 3 || x < 3 { 0.0 } else { 1.0 };
+            assert!((0..40).all(|x| row[x] == expected(x)), "row {y}: {row:?}");
+        }
     }
 
     #[test]
