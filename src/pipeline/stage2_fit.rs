@@ -60,7 +60,8 @@ pub struct MotionFit {
     pub curve: Vec<f32>,
     /// The Gaussians: refined with joint refinement, else as given.
     pub gaussians: Gaussians,
-    /// The share of the compared views' pixels left in the loss (1 without masks).
+    /// The share of the compared views' pixels left in the loss by the last masks drawn (1 without
+    /// masks).
     pub kept: f64,
 }
 
@@ -107,8 +108,8 @@ fn stratified(total: usize, count: usize, rng: &mut Rng) -> Vec<usize> {
 /// Fits `model`'s parameters, starting from `start` (SI), to `views` of `scene`; the Gaussians
 /// `g` are held fixed unless `fit.refine` is set. With `fit.disocclusion_margin` set, the
 /// disocclusion masks are derived from `central_disparity` (the central view's disparity, e.g.
-/// the stage-1 render) and the current motion estimate; without a map no pixel is masked. `progress(step, total, loss)` is
-/// called after each step.
+/// the stage-1 render) and the current motion estimate; without a map no pixel is masked.
+/// `progress(step, total, loss)` is called after each step.
 #[allow(clippy::too_many_arguments)]
 pub fn fit_stage2(
     g: Gaussians,
