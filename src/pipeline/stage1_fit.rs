@@ -1,7 +1,7 @@
 //! Stage-1 fit: Adam on every Gaussian parameter against views of the central row (which hold no
 //! motion), one learning rate per parameter group.
 
-use super::targets::{band_tensor, view_targets};
+use super::targets::{ViewTarget, band_tensor, view_targets};
 use crate::geometry::ViewId;
 use crate::io::{Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
@@ -75,7 +75,7 @@ pub fn fit_stage1(
     // Band targets are cut once: `[P, C]` per (band, view).
     let band_targets: Vec<Vec<Tensor<2>>> = bands
         .iter()
-        .map(|rows| targets.iter().map(|(_, img)| band_tensor(img, rows.clone(), device)).collect())
+        .map(|rows| targets.iter().map(|t| band_tensor(t.image, rows.clone(), device)).collect())
         .collect();
     let default = GroupPlan { schedule: Schedule::Constant(fit.lr.position), adam_epsilon: fit.adam_epsilon };
     let stage = Stage { iterations: fit.iterations, plan: with_gaussian_groups(Plan::new(default), &g, &fit.lr, fit.adam_epsilon) };
@@ -83,7 +83,7 @@ pub fn fit_stage1(
         let b = step % bands.len();
         let set = g.to_set();
         let mut loss = MeanLoss::default();
-        for ((offset, _), target) in targets.iter().zip(&band_targets[b]) {
+        for (ViewTarget { offset, .. }, target) in targets.iter().zip(&band_targets[b]) {
             let bins = bins_for_view(&set, *offset, w, bands[b].clone(), &fit.render);
             let out = render(g, *offset, &bins, device);
             loss.add(losses.evaluate(&LossInput { rendered: &out, target, rows: bands[b].len(), width: w, motion: None }));

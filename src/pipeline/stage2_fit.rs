@@ -2,7 +2,7 @@
 //! lifts the Gaussians, moves them back to t = 0 under the current motion, re-images them with
 //! rolling shutter into each view and compares a stratified sample of row bands.
 
-use super::targets::{band_tensor, view_targets};
+use super::targets::{ViewTarget, band_tensor, view_targets};
 use super::visibility::{explained_mask_moving, masked};
 use crate::geometry::{Camera, TensorCamera, ViewId};
 use crate::io::{MotionRecord, Raster, Scene};
@@ -132,13 +132,12 @@ pub fn fit_stage2(
     let targets = view_targets(scene, views);
     // Band targets are cut once: `[P, C]` per (view, band).
     let band_targets: Vec<Vec<Tensor<2>>> =
-        targets.iter().map(|(_, img)| all_bands.iter().map(|(rows, _)| band_tensor(img, rows.clone(), device)).collect()).collect();
+        targets.iter().map(|t| all_bands.iter().map(|(rows, _)| band_tensor(t.image, rows.clone(), device)).collect()).collect();
     // Disocclusion masks, cut like the targets: `[P, 1]` per (view, band). They follow the
     // motion: redrawn from the current estimate every `MASK_REFRESH` steps.
-    let present: Vec<ViewId> = views.iter().copied().filter(|&v| scene.view(v).is_some()).collect();
     let draw_masks = |motion: &MotionRecord| -> Option<(f64, Vec<Vec<Tensor<2>>>)> {
         let (margin, disparity) = fit.disocclusion_margin.zip(central_disparity)?;
-        let maps: Vec<Raster> = present.iter().map(|&view| explained_mask_moving(disparity, camera, view, motion, margin)).collect();
+        let maps: Vec<Raster> = targets.iter().map(|t| explained_mask_moving(disparity, camera, t.view, motion, margin)).collect();
         let values = maps.iter().flat_map(|r| &r.data);
         let kept = values.clone().map(|&x| x as f64).sum::<f64>() / values.count().max(1) as f64;
         let cut = maps.iter().map(|mask| all_bands.iter().map(|(rows, _)| band_tensor(mask, rows.clone(), device)).collect()).collect();
@@ -164,7 +163,7 @@ pub fn fit_stage2(
         let shape = StaticShape::new(&m.gaussians, tc, model, params.clone());
         let scaled = m.motion.scaled.val();
         let mut loss = MeanLoss::default();
-        for (v, ((offset, _), view_bands)) in targets.iter().zip(&band_targets).enumerate() {
+        for (v, (ViewTarget { offset, .. }, view_bands)) in targets.iter().zip(&band_targets).enumerate() {
             let rolling = match fit.timing {
                 RsTiming::PerGaussian(iterations) => Some(shape.splats_rolling(model, params.clone(), *offset, iterations)),
                 RsTiming::Bands(_) => None,

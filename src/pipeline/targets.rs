@@ -5,13 +5,23 @@ use crate::io::{Raster, Scene};
 use burn::tensor::{Device, Tensor, TensorData};
 use std::ops::Range;
 
-/// The present views of `views`, each with its offset `(c - cc, r - rc)`.
-pub fn view_targets<'a>(scene: &'a Scene, views: &[ViewId]) -> Vec<((f32, f32), &'a Raster)> {
+/// One observed view a fit compares against.
+pub struct ViewTarget<'a> {
+    /// Which view.
+    pub view: ViewId,
+    /// Its offset `(c - cc, r - rc)` from the central view.
+    pub offset: (f32, f32),
+    /// Its pixels.
+    pub image: &'a Raster,
+}
+
+/// The present views of `views`.
+pub fn view_targets<'a>(scene: &'a Scene, views: &[ViewId]) -> Vec<ViewTarget<'a>> {
     views
         .iter()
-        .filter_map(|&v| {
-            let (dx, dy) = scene.grid.offset(v);
-            Some(((dx as f32, dy as f32), scene.view(v)?))
+        .filter_map(|&view| {
+            let (dx, dy) = scene.grid.offset(view);
+            Some(ViewTarget { view, offset: (dx as f32, dy as f32), image: scene.view(view)? })
         })
         .collect()
 }
