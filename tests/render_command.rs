@@ -36,11 +36,14 @@ fn train(dir: &Path, scene: &str, name: &str, motion_steps: usize) -> String {
     models.join(name).to_str().unwrap().to_string()
 }
 
-/// The PSNR `rslf render` printed for view `index`.
+/// The PSNR `rslf render` printed for view `index` of its 9x9 grid (row `index / 9`, column
+/// `index % 9`).
 fn view_psnr(stdout: &str, index: usize) -> f64 {
-    let prefix = format!("view {index:3}: PSNR ");
-    let line = stdout.lines().find_map(|l| l.trim_start().strip_prefix(prefix.trim_start())).unwrap_or_else(|| panic!("no view {index}: {stdout}"));
-    line.trim_end_matches(" dB").parse().unwrap()
+    let row = format!("r{}", index / 9);
+    let line = stdout.lines().find(|l| l.split_whitespace().next() == Some(row.as_str())).unwrap_or_else(|| panic!("no grid row {row}: {stdout}"));
+    let cells: Vec<&str> = line.split_whitespace().skip(1).collect();
+    assert_eq!(cells.len(), 9, "{line}");
+    cells[index % 9].parse().unwrap_or_else(|_| panic!("view {index}: {line}"))
 }
 
 #[test]

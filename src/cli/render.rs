@@ -99,11 +99,34 @@ pub fn run(args: RenderArgs) -> crate::Result<()> {
             (i, psnr_db(&views[i], scene.view(v).expect("present"), &region))
         })
         .collect();
-    for (i, db) in &scores {
-        println!("  view {i:3}: PSNR {db:.2} dB");
-    }
+    print!("{}", psnr_grid(&scene, &scores));
     let mean = scores.iter().map(|(_, db)| db).sum::<f64>() / scores.len() as f64;
     let (worst_view, worst) = scores.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).expect("a scene has its central view");
     println!("PSNR against the {} input views of {}: mean {mean:.2} dB, lowest {worst:.2} dB (view {worst_view})", scores.len(), scene_dir.display());
     Ok(())
+}
+
+/// The PSNR of each view laid out as the view grid: one line per view row (top to bottom),
+/// one column per view column (left to right), `-` for a view the scene lacks. Read along a
+/// row or column, it shows how the model holds up away from the views it was fitted to.
+fn psnr_grid(scene: &Scene, scores: &[(usize, f64)]) -> String {
+    let grid = scene.grid;
+    let mut cells = vec![None; grid.len()];
+    for &(i, db) in scores {
+        cells[i] = Some(db);
+    }
+    let mut text = String::from("PSNR (dB) per view, by view row and column:\n     ");
+    for col in 0..grid.cols {
+        text += &format!(" {:>6}", format!("c{col}"));
+    }
+    for row in 0..grid.rows {
+        text += &format!("\n  {:>3}", format!("r{row}"));
+        for col in 0..grid.cols {
+            match cells[grid.index(crate::geometry::ViewId { row, col })] {
+                Some(db) => text += &format!(" {db:>6.2}"),
+                None => text += &format!(" {:>6}", "-"),
+            }
+        }
+    }
+    text + "\n"
 }
