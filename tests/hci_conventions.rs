@@ -5,6 +5,7 @@ mod common;
 use common::{hci, rslf};
 use rslf::geometry::{ViewGrid, ViewId};
 use rslf::io::{Scene, read_pfm};
+use rslf::pipeline::stage1_views;
 
 #[test]
 fn antinous_loads_81_views_of_512x512_without_a_camera() {
@@ -30,6 +31,19 @@ fn cotton_loads_33_views_with_its_central_row_corners_and_camera() {
     assert!((cam.baseline_m - 0.025).abs() < 1e-12 && (cam.focus_m - 4.25).abs() < 1e-12);
     assert!(!scene.is_rolling_shutter());
     assert_eq!(scene.params.as_ref().unwrap().disparity_range, Some((-1.6, 1.5)));
+}
+
+#[test]
+fn stage_1_takes_cotton_central_row_then_its_central_column_nearest_first() {
+    let scene = Scene::load(&hci("cotton")).unwrap();
+    let v = |row, col| ViewId { row, col };
+    // The paper's choice: the central row only.
+    assert_eq!(stage1_views(&scene, 5, 0), (2..7).map(|c| v(4, c)).collect::<Vec<_>>());
+    // Cotton ships its whole central column: the nearest views above and below come first.
+    assert_eq!(stage1_views(&scene, 3, 2), vec![v(4, 3), v(4, 4), v(4, 5), v(3, 4), v(5, 4)]);
+    let all = stage1_views(&scene, 9, 20);
+    assert_eq!(all.len(), 17, "9 views of the row and the 8 others of the column: {all:?}");
+    assert!(all.iter().all(|x| x.row == 4 || x.col == 4));
 }
 
 #[test]

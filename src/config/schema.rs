@@ -60,6 +60,12 @@ pub struct Stage1Config {
     pub iterations: usize,
     /// How many views of the central row to fit, centred on the central view.
     pub views: usize,
+    /// How many views of the central column to fit too, nearest the central view first (0 = the
+    /// paper's central row only). They hold the vertical parallax the row lacks (the disparity
+    /// of horizontal edges), but read a point of disparity `d` in view row `r` at `(r-rc) d`
+    /// rows from where the central view does, so motion in those `(r-rc) d` line times bends
+    /// them slightly.
+    pub column_views: usize,
     /// Rows per band: each Adam step renders one band in every view.
     pub band_height: usize,
     /// Disparity search range `[min, max]` of the initial plane sweep, pixels; default: the
@@ -89,6 +95,7 @@ impl Default for Stage1Config {
             gaussians: 20_000,
             iterations: 100,
             views: 5,
+            column_views: 0,
             band_height: 64,
             disparity_range: None,
             disparity_step: 0.05,

@@ -55,15 +55,21 @@ pub fn render_settings(config: &Config) -> RenderSettings {
     RenderSettings { max_per_pixel: config.render.max_per_pixel, cutoff_sigma: config.render.cutoff_sigma as f32 }
 }
 
-/// The `count` central-row views the stage-1 fit uses: the central view and its nearest
-/// neighbours on the row, alternating sides.
-pub fn stage1_views(scene: &Scene, count: usize) -> Vec<ViewId> {
+/// The views the stage-1 fit uses: `row` views of the central row (the central view and its
+/// nearest neighbours on the row, alternating sides), then `column` views of the central column
+/// (nearest the central view first, alternating sides; the central view is not counted again).
+pub fn stage1_views(scene: &Scene, row: usize, column: usize) -> Vec<ViewId> {
     let centre = scene.central_id();
-    let mut row = scene.central_row_views();
-    row.sort_by_key(|v| (v.col.abs_diff(centre.col), v.col));
-    row.truncate(count);
-    row.sort();
-    row
+    let mut on_row = scene.central_row_views();
+    on_row.sort_by_key(|v| (v.col.abs_diff(centre.col), v.col));
+    on_row.truncate(row);
+    on_row.sort();
+    let mut on_column: Vec<ViewId> = scene.present_views().into_iter().filter(|v| v.col == centre.col && v.row != centre.row).collect();
+    on_column.sort_by_key(|v| (v.row.abs_diff(centre.row), v.row));
+    on_column.truncate(column);
+    on_column.sort();
+    on_row.extend(on_column);
+    on_row
 }
 
 /// The registries a run draws its loss terms and motion models from. The defaults hold the
@@ -268,7 +274,7 @@ fn stage1(
     let mut gaussians = set.to_module(device);
     log.lines.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
 
-    let views = stage1_views(scene, config.stage1.views);
+    let views = stage1_views(scene, config.stage1.views, config.stage1.column_views);
     let mut curves = Vec::new();
     if config.stage1.iterations > 0 {
         let s = &config.stage1;
@@ -288,10 +294,11 @@ fn stage1(
         bar.finish_and_clear();
         gaussians = fitted;
         log.lines.push(format!(
-            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row views, loss ({}) {:.4} -> {:.4}, {:.1} s",
+            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4}, {:.1} s",
             s.iterations,
             s.band_height,
-            views.len(),
+            views.iter().filter(|v| v.row == scene.central_id().row).count(),
+            views.iter().filter(|v| v.row != scene.central_id().row).count(),
             losses.names().join(" + "),
             curve.first().copied().unwrap_or(f32::NAN),
             curve.last().copied().unwrap_or(f32::NAN),
@@ -320,7 +327,7 @@ fn stage2(
     let mut views = stage2_views(scene, s.views);
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
-        views.extend(stage1_views(scene, s1.views));
+        views.extend(stage1_views(scene, s1.views, s1.column_views));
         let lr = LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
         (lr, s1.adam_epsilon as f32)
     });

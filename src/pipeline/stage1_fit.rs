@@ -1,5 +1,5 @@
 //! Stage-1 fit: Adam on every Gaussian parameter against views of the central row (which hold no
-//! motion), one learning rate per parameter group.
+//! motion) and, if asked, of the central column, one learning rate per parameter group.
 
 use super::targets::{ViewTarget, band_tensor, view_targets};
 use crate::geometry::ViewId;
@@ -56,8 +56,8 @@ pub fn with_gaussian_groups(plan: Plan, g: &Gaussians, lr: &LearningRates, adam_
 /// Fits `g` to `views` of `scene` under `losses`; returns the fitted Gaussians and the loss of
 /// each step.
 /// Each step renders the same band of rows in every view (the views of the central row see a
-/// point on the same row), so that every step weighs all the disparity cues; bands are taken
-/// in turn. `progress(step, total, loss)` is called after each step.
+/// point on the same row, those of the central column within a few rows of it), so that every
+/// step weighs all the disparity cues; bands are taken in turn. `progress(step, total, loss)` is called after each step.
 pub fn fit_stage1(
     g: Gaussians,
     scene: &Scene,
