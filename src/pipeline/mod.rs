@@ -371,18 +371,22 @@ fn stage2(
     fitted
 }
 
-/// The plane sweep over the central row: the initial disparity map.
+/// The plane sweep over the central row (and the stage-1 views of the central column): the
+/// initial disparity map.
 fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
     let settings = sweep_settings(config, scene);
     let row_views = scene.central_row_views();
+    let column_views = stage1_views(scene, 0, config.stage1.column_views);
+    let views: Vec<ViewId> = row_views.iter().chain(&column_views).copied().collect();
     let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
     let bar = crate::progress::bar(labels, "stage 1: sweep");
     let start = Instant::now();
-    let estimate = plane_sweep(scene, &row_views, &settings, |done, _| bar.set_position(done as u64));
+    let estimate = plane_sweep(scene, &views, &settings, |done, _| bar.set_position(done as u64));
     bar.finish_and_clear();
     log.lines.push(format!(
-        "stage 1 initialisation: plane sweep over {} central-row views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
+        "stage 1 initialisation: plane sweep over {} central-row and {} central-column views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
         row_views.len(),
+        column_views.len(),
         settings.range.0,
         settings.range.1,
         labels,

@@ -1,10 +1,14 @@
-//! Stage-1 initial disparity: a plane sweep over the views of the central row.
+//! Stage-1 initial disparity: a plane sweep over the views of the central row, and of the
+//! central column when stage 1 fits some.
 //!
 //! The views of the central row read every image row at the same instant, so the disparity
-//! between them holds no motion. For each candidate disparity `d`, each view (offset `dx`) is
-//! sampled at `u - dx d` on the same row and compared with the central view. Occlusions are
+//! between them holds no motion. For each candidate disparity `d`, each view (offset `(dx, dy)`)
+//! is sampled at `(u - dx d, v - dy d)` and compared with the central view. Occlusions are
 //! handled by keeping the better of the two half-rows (views left of centre, views right of
-//! centre): a point hidden on one side is usually visible on the other. Costs are averaged over
+//! centre): a point hidden on one side is usually visible on the other. Views of the central
+//! column, if given, form two half-columns kept the same way, and the row's and the column's
+//! costs are averaged: the column pins the disparity of horizontal edges, which the row cannot
+//! see move (the row alone is used when no column view is given). Costs are averaged over
 //! a square window, the best candidate is refined to sub-pixel precision by a parabola, and the
 //! depth of the cost minimum below the mean cost of all candidates is kept as a confidence. Where the cost curve is flat (uniform
 //! regions wider than the window) the minimum means nothing: those pixels take the disparity of
@@ -39,24 +43,29 @@ pub struct DisparityEstimate {
     pub confidence: Raster,
 }
 
-/// Mean absolute difference per pixel against the central view, over `views`, for disparity `d`;
-/// `INFINITY` where no view sees the pixel.
-fn half_cost(central: &Raster, views: &[(f32, &Raster)], d: f32, out: &mut [f32]) {
-    let (w, ch) = (central.width, central.channels);
+/// Mean absolute difference per pixel against the central view, over `views` (each with its
+/// offset `(dx, dy)` from the central view), for disparity `d`; `INFINITY` where no view sees
+/// the pixel.
+fn half_cost(central: &Raster, views: &[((f32, f32), &Raster)], d: f32, out: &mut [f32]) {
+    let (w, h, ch) = (central.width, central.height, central.channels);
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         for (x, cost) in row.iter_mut().enumerate() {
             let (mut sum, mut n) = (0.0f32, 0u32);
-            for &(dx, view) in views {
-                let xs = x as f32 - dx * d;
-                if xs < 0.0 || xs > (w - 1) as f32 {
+            for &((dx, dy), view) in views {
+                let (xs, ys) = (x as f32 - dx * d, y as f32 - dy * d);
+                if xs < 0.0 || xs > (w - 1) as f32 || ys < 0.0 || ys > (h - 1) as f32 {
                     continue;
                 }
-                let x0 = (xs as usize).min(w.saturating_sub(2));
-                let f = xs - x0 as f32;
-                let (a, b) = ((y * w + x0) * ch, (y * w + (x0 + 1).min(w - 1)) * ch);
-                for c in 0..ch {
-                    let s = view.data[a + c] * (1.0 - f) + view.data[b + c] * f;
-                    sum += (s - central.data[(y * w + x) * ch + c]).abs();
+                let (x0, y0) = ((xs as usize).min(w.saturating_sub(2)), (ys as usize).min(h.saturating_sub(2)));
+                let (fx, fy) = (xs - x0 as f32, ys - y0 as f32);
+                let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+                let at = |xx: usize, yy: usize| (yy * w + xx) * ch;
+                let (a, b, c, e) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
+                for k in 0..ch {
+                    let top = view.data[a + k] * (1.0 - fx) + view.data[b + k] * fx;
+                    // Row views (dy = 0) sample their own row only: fy is 0.
+                    let s = if fy == 0.0 { top } else { top * (1.0 - fy) + (view.data[c + k] * (1.0 - fx) + view.data[e + k] * fx) * fy };
+                    sum += (s - central.data[(y * w + x) * ch + k]).abs();
                 }
                 n += ch as u32;
             }
@@ -100,8 +109,8 @@ fn box_mean(src: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
     out
 }
 
-/// Runs the sweep on `views` (views of the central row; others are ignored), calling
-/// `progress(done, total)` after each candidate.
+/// Runs the sweep on `views` (views of the central row and of the central column; others are
+/// ignored), calling `progress(done, total)` after each candidate.
 pub fn plane_sweep(
     scene: &Scene,
     views: &[ViewId],
@@ -111,14 +120,25 @@ pub fn plane_sweep(
     let central = scene.central();
     let (w, h) = (central.width, central.height);
     let centre = scene.central_id();
-    let mut left = Vec::new();
-    let mut right = Vec::new();
-    for &v in views.iter().filter(|v| v.row == centre.row && v.col != centre.col) {
+    // Half-rows (left, right) and half-columns (above, below) of the central view.
+    let mut halves: [Vec<((f32, f32), &Raster)>; 4] = Default::default();
+    for &v in views.iter().filter(|v| (v.row == centre.row) != (v.col == centre.col)) {
         if let Some(img) = scene.view(v) {
-            let dx = scene.grid.offset(v).0 as f32;
-            if dx < 0.0 { left.push((dx, img)) } else { right.push((dx, img)) }
+            let (dx, dy) = scene.grid.offset(v);
+            let half = match (v.row == centre.row, dx < 0.0, dy < 0.0) {
+                (true, true, _) => 0,
+                (true, false, _) => 1,
+                (false, _, true) => 2,
+                (false, _, false) => 3,
+            };
+            halves[half].push(((dx as f32, dy as f32), img));
         }
     }
+    let with_column = !halves[2].is_empty() || !halves[3].is_empty();
+    // The row's and the column's costs are weighed by their views' total distance from the
+    // centre: a longer baseline resolves the disparity more finely.
+    let reach = |pair: &[Vec<((f32, f32), &Raster)>]| pair.iter().flatten().map(|((dx, dy), _)| dx.abs() + dy.abs()).sum::<f32>();
+    let column_share = reach(&halves[2..]) / (reach(&halves[..2]) + reach(&halves[2..])).max(f32::MIN_POSITIVE);
     let (lo, hi) = settings.range;
     let labels = (((hi - lo) / settings.step).round() as usize + 1).max(1);
     let n = w * h;
@@ -127,13 +147,28 @@ pub fn plane_sweep(
     let mut after = vec![f32::INFINITY; n];
     let mut previous = vec![f32::INFINITY; n];
     let mut total = vec![(0.0f32, 0u32); n];
-    let (mut cl, mut cr) = (vec![0.0f32; n], vec![0.0f32; n]);
+    let mut raw = vec![0.0f32; n];
+    // The better half of a pair, window-averaged: `INFINITY` where neither half sees the pixel.
+    let mut pair = |a: &[((f32, f32), &Raster)], b: &[((f32, f32), &Raster)], d: f32| -> Vec<f32> {
+        half_cost(central, a, d, &mut raw);
+        let first = box_mean(&raw, w, h, settings.window_radius);
+        half_cost(central, b, d, &mut raw);
+        let second = box_mean(&raw, w, h, settings.window_radius);
+        first.iter().zip(&second).map(|(x, y)| x.min(*y)).collect()
+    };
     for l in 0..labels {
         let d = (lo + l as f64 * settings.step) as f32;
-        half_cost(central, &left, d, &mut cl);
-        half_cost(central, &right, d, &mut cr);
-        let (bl, br) = (box_mean(&cl, w, h, settings.window_radius), box_mean(&cr, w, h, settings.window_radius));
-        let cost: Vec<f32> = bl.iter().zip(&br).map(|(a, b)| a.min(*b)).collect();
+        let mut cost = pair(&halves[0], &halves[1], d);
+        if with_column {
+            let column = pair(&halves[2], &halves[3], d);
+            for (c, k) in cost.iter_mut().zip(&column) {
+                *c = match (c.is_finite(), k.is_finite()) {
+                    (true, true) => (1.0 - column_share) * *c + column_share * k,
+                    (false, _) => *k,
+                    (true, false) => *c,
+                };
+            }
+        }
         best.par_iter_mut()
             .zip(before.par_iter_mut())
             .zip(after.par_iter_mut())
