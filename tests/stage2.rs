@@ -47,7 +47,13 @@ fn each_motion_model_runs_by_config_and_writes_format_results() {
     for model in ["constant_velocity", "constant_acceleration", "piecewise_constant"] {
         // One run also masks the disocclusions: it says how much of the views it compared.
         let masked = model == "constant_acceleration";
-        let extra = if masked { "iterations = 10\nmask_disocclusions = true" } else { "iterations = 10" };
+        // And one weighs the off-row pixels by their horizontal gradient share.
+        let weighted = model == "piecewise_constant";
+        let extra = match (masked, weighted) {
+            (true, _) => "iterations = 10\nmask_disocclusions = true",
+            (_, true) => "iterations = 10\naperture_weighting = true",
+            _ => "iterations = 10",
+        };
         let stdout = train(root.path(), &config(root.path(), model, model, extra), model);
         assert!(stdout.contains(&format!("stage 2 fit: `{model}` motion")), "{stdout}");
         if masked {
@@ -56,6 +62,7 @@ fn each_motion_model_runs_by_config_and_writes_format_results() {
         } else {
             assert!(stdout.contains("every pixel compared"), "{stdout}");
         }
+        assert_eq!(stdout.contains("weighted by their horizontal gradient share"), weighted, "{stdout}");
         let out = root.path().join(model);
         let motion = MotionRecord::read(&out.join("motion.toml")).unwrap();
         assert_eq!(motion.model_name(), model);

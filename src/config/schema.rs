@@ -167,6 +167,10 @@ pub struct Stage2Config {
     pub mask_disocclusions: bool,
     /// Pixels by which that mask is widened around each pixel no central-view pixel reaches.
     pub disocclusion_margin: usize,
+    /// Weigh each pixel of an off-row view by the share of its local gradient energy that is
+    /// horizontal, so that horizontal edges (whose disparity the central row cannot fix, and
+    /// whose vertical displacement a disparity error imitates exactly) do not bend the motion.
+    pub aperture_weighting: bool,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
     pub initial_motion: Option<PathBuf>,
@@ -187,6 +191,7 @@ impl Default for Stage2Config {
             refine_gaussians: 1.0,
             mask_disocclusions: false,
             disocclusion_margin: 2,
+            aperture_weighting: false,
             initial_motion: None,
         }
     }

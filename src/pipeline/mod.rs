@@ -1,6 +1,7 @@
 //! The RSLF composition: stage-1 initialisation (plane sweep, Gaussian sampling), stage-1 fit,
 //! then stage 2 (motion) as it arrives, and the result.
 
+mod aperture;
 mod gaussian_init;
 mod light_field;
 mod plane_sweep;
@@ -10,6 +11,7 @@ mod stage2_fit;
 mod targets;
 mod visibility;
 
+pub use aperture::aperture_weights;
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
@@ -343,6 +345,7 @@ fn stage2(
         render: render_settings(config),
         refine,
         disocclusion_margin: s.mask_disocclusions.then_some(s.disocclusion_margin),
+        aperture_weighting: s.aperture_weighting,
     };
     let bar = crate::progress::bar(s.iterations as u64, "stage 2: motion");
     let start = Instant::now();
@@ -352,7 +355,7 @@ fn stage2(
     });
     bar.finish_and_clear();
     log.lines.push(format!(
-        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}, loss {:.4} -> {:.4}, {:.1} s",
+        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}, loss {:.4} -> {:.4}, {:.1} s",
         model.name(),
         s.iterations,
         s.bands_per_step,
@@ -364,6 +367,7 @@ fn stage2(
         } else {
             "every pixel compared".to_string()
         },
+        if fit.aperture_weighting { ", off-row pixels weighted by their horizontal gradient share" } else { "" },
         fitted.curve.first().copied().unwrap_or(f32::NAN),
         fitted.curve.last().copied().unwrap_or(f32::NAN),
         start.elapsed().as_secs_f64()

@@ -2,6 +2,7 @@
 //! lifts the Gaussians, moves them back to t = 0 under the current motion, re-images them with
 //! rolling shutter into each view and compares a stratified sample of row bands.
 
+use super::aperture::aperture_weights;
 use super::targets::{ViewTarget, band_tensor, view_targets};
 use super::visibility::{explained_mask_moving, masked};
 use crate::geometry::{Camera, TensorCamera, ViewId};
@@ -44,10 +45,20 @@ pub struct Stage2Fit {
     /// When set, the pixels of each view that no pixel of the central view reaches, widened by
     /// this many pixels, are left out of the loss (see [`explained_mask_moving`]).
     pub disocclusion_margin: Option<usize>,
+    /// Weigh the pixels of the views off the central row by [`aperture_weights`], so that the
+    /// residuals a disparity error can explain as well as a vertical motion do not pull.
+    pub aperture_weighting: bool,
 }
 
 /// Steps between two redrawings of the disocclusion masks from the current motion.
 const MASK_REFRESH: usize = 10;
+
+/// Half-width of the window the aperture weights sum gradients over (a 5x5 window).
+const APERTURE_RADIUS: usize = 2;
+
+/// Squared gradient (per window) below which a region counts as flat and gets weight 1/2:
+/// an edge of contrast 0.1 summed over a 5x5 window is about 1e-2.
+const APERTURE_EPS: f32 = 1e-4;
 
 /// What the fit found.
 #[derive(Debug, Clone)]
@@ -144,6 +155,16 @@ pub fn fit_stage2(
         Some((kept, cut))
     };
     let mut masks = draw_masks(&model.record(start));
+    // Aperture weights of the off-row views, cut like the targets: `[P, 1]` per (view, band).
+    let aperture: Vec<Option<Vec<Tensor<2>>>> = targets
+        .iter()
+        .map(|t| {
+            (fit.aperture_weighting && t.offset.1 != 0.0).then(|| {
+                let weights = aperture_weights(t.image, APERTURE_RADIUS, APERTURE_EPS);
+                all_bands.iter().map(|(rows, _)| band_tensor(&weights, rows.clone(), device)).collect()
+            })
+        })
+        .collect();
     let motion_plan = GroupPlan {
         schedule: Schedule::Cosine { start: fit.lr, end: fit.lr_final, steps: fit.iterations },
         adam_epsilon: fit.adam_epsilon,
@@ -178,6 +199,10 @@ pub fn fit_stage2(
                 let (out, target) = match &masks {
                     Some((_, masks)) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
                     None => (out, view_bands[b].clone()),
+                };
+                let (out, target) = match &aperture[v] {
+                    Some(weights) => masked(out, target, weights[b].clone()),
+                    None => (out, target),
                 };
                 let input = LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion: Some(&scaled) };
                 loss.add(losses.evaluate(&input));

@@ -68,9 +68,9 @@ fn mask_of_landings(disparity: &Raster, margin: usize, landing: impl Fn(f64, f64
     Raster { width: w, height: h, channels: 1, data }
 }
 
-/// A band's render and target with the pixels `mask` (`[P, 1]`, 0 or 1) leaves out set to zero
-/// in both colours, so that every photometric term sees no difference there. Opacity and
-/// disparity are kept: they are the model's own, not compared with the view.
+/// A band's render and target with both colours multiplied by `mask` (`[P, 1]`): where it is 0
+/// every photometric term sees no difference, where it is in (0, 1) a proportionally smaller
+/// one. Opacity and disparity are kept: they are the model's own, not compared with the view.
 pub fn masked(rendered: RenderOutput, target: Tensor<2>, mask: Tensor<2>) -> (RenderOutput, Tensor<2>) {
     let colour = rendered.colour * mask.clone();
     (RenderOutput { colour, ..rendered }, target * mask)
