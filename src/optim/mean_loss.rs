@@ -1,4 +1,4 @@
-//! The mean of the loss terms a step collects (one per band and view).
+//! The mean (or sum) of the loss terms a step collects (one per band and view).
 
 use burn::tensor::Tensor;
 
@@ -19,6 +19,11 @@ impl MeanLoss {
             });
             self.count += 1;
         }
+    }
+
+    /// The sum of the terms added, or `None` when none was.
+    pub fn sum(self) -> Option<Tensor<1>> {
+        self.sum
     }
 
     /// The mean of the terms added, or `None` when none was.

@@ -13,7 +13,7 @@ use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionParams, ScaleContext, parameter_scales};
 use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
 use crate::random::Rng;
-use crate::render::{RenderSettings, RsTiming, StaticShape, bands, splat};
+use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, bands, splat};
 use burn::module::Module;
 use burn::tensor::{Device, Tensor};
 
@@ -74,6 +74,16 @@ pub struct MotionFit {
     /// The share of the compared views' pixels left in the loss by the last masks drawn (1 without
     /// masks).
     pub kept: f64,
+}
+
+/// One rendering of the compared views: the static shape and motion parameters it is drawn with
+/// (either may be held, i.e. carry no gradient), whether the aperture weights apply, and whether
+/// the motion prior is counted.
+struct Pass {
+    shape: StaticShape,
+    params: Tensor<1>,
+    weighted: bool,
+    prior: bool,
 }
 
 /// What stage 2 optimises: the scaled motion parameters and the Gaussians (frozen unless the
@@ -181,31 +191,51 @@ pub fn fit_stage2(
             masks = draw_masks(&model.record(&m.motion.si_values(&scales)));
         }
         let params = m.motion.si(&scales);
-        let shape = StaticShape::new(&m.gaussians, tc, model, params.clone());
         let scaled = m.motion.scaled.val();
+        let joint = Pass { shape: StaticShape::new(&m.gaussians, tc, model, params.clone()), params: params.clone(), weighted: true, prior: true };
+        // Under joint refinement an aperture-weighted view is rendered twice: the motion's pass
+        // (Gaussians held) compares the weighted residual, the Gaussians' pass (motion held)
+        // every pixel, so the geometry still learns from the horizontal edges the motion ignores.
+        let split = (fit.refine.is_some() && aperture.iter().any(Option::is_some)).then(|| {
+            [
+                Pass { shape: StaticShape::new(&m.gaussians.clone().no_grad(), tc, model, params.clone()), params: params.clone(), weighted: true, prior: true },
+                Pass { shape: StaticShape::new(&m.gaussians, tc, model, params.clone().detach()), params: params.clone().detach(), weighted: false, prior: false },
+            ]
+        });
         let mut loss = MeanLoss::default();
         for (v, (ViewTarget { offset, .. }, view_bands)) in targets.iter().zip(&band_targets).enumerate() {
-            let rolling = match fit.timing {
-                RsTiming::PerGaussian(iterations) => Some(shape.splats_rolling(model, params.clone(), *offset, iterations)),
-                RsTiming::Bands(_) => None,
+            let passes: &[Pass] = match (&aperture[v], &split) {
+                (Some(_), Some(split)) => split,
+                _ => std::slice::from_ref(&joint),
             };
+            let rolling: Vec<Option<Splats>> = passes
+                .iter()
+                .map(|p| match fit.timing {
+                    RsTiming::PerGaussian(iterations) => Some(p.shape.splats_rolling(model, p.params.clone(), *offset, iterations)),
+                    RsTiming::Bands(_) => None,
+                })
+                .collect();
             for b in stratified(all_bands.len(), fit.bands_per_step, &mut rng) {
                 let (rows, tau) = all_bands[b].clone();
-                let splats = match &rolling {
-                    Some(s) => s.clone(),
-                    None => shape.splats_at_time(model, params.clone(), *offset, tau.expect("bands have a time")),
-                };
-                let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
-                let (out, target) = match &masks {
-                    Some((_, masks)) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
-                    None => (out, view_bands[b].clone()),
-                };
-                let (out, target) = match &aperture[v] {
-                    Some(weights) => masked(out, target, weights[b].clone()),
-                    None => (out, target),
-                };
-                let input = LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion: Some(&scaled) };
-                loss.add(losses.evaluate(&input));
+                let mut band_loss = MeanLoss::default();
+                for (pass, rolling) in passes.iter().zip(&rolling) {
+                    let splats = match rolling {
+                        Some(s) => s.clone(),
+                        None => pass.shape.splats_at_time(model, pass.params.clone(), *offset, tau.expect("bands have a time")),
+                    };
+                    let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
+                    let (out, target) = match &masks {
+                        Some((_, masks)) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
+                        None => (out, view_bands[b].clone()),
+                    };
+                    let (out, target) = match (&aperture[v], pass.weighted) {
+                        (Some(weights), true) => masked(out, target, weights[b].clone()),
+                        _ => (out, target),
+                    };
+                    let motion = pass.prior.then_some(&scaled);
+                    band_loss.add(losses.evaluate(&LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion }));
+                }
+                loss.add(band_loss.sum());
             }
         }
         loss.mean()
