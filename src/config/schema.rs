@@ -167,9 +167,10 @@ pub struct Stage2Config {
     pub mask_disocclusions: bool,
     /// Pixels by which that mask is widened around each pixel no central-view pixel reaches.
     pub disocclusion_margin: usize,
-    /// Weigh each pixel of an off-row view by the share of its local gradient energy that is
-    /// horizontal, so that horizontal edges (whose disparity the central row cannot fix, and
-    /// whose vertical displacement a disparity error imitates exactly) do not bend the motion.
+    /// Weigh each pixel of an off-row view, in the motion's residual, by the share of its local
+    /// gradient energy that is horizontal, so that horizontal edges (whose disparity the central
+    /// row cannot fix, and whose vertical displacement a disparity error imitates exactly) do not
+    /// bend the motion. Under joint refinement the Gaussians still compare every pixel.
     pub aperture_weighting: bool,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.

@@ -45,8 +45,9 @@ pub struct Stage2Fit {
     /// When set, the pixels of each view that no pixel of the central view reaches, widened by
     /// this many pixels, are left out of the loss (see [`explained_mask_moving`]).
     pub disocclusion_margin: Option<usize>,
-    /// Weigh the pixels of the views off the central row by [`aperture_weights`], so that the
-    /// residuals a disparity error can explain as well as a vertical motion do not pull.
+    /// Weigh the pixels of the views off the central row by [`aperture_weights`] in the motion's
+    /// residual, so that residuals a disparity error could equally have caused do not pull the
+    /// motion; under joint refinement the Gaussians still compare every pixel.
     pub aperture_weighting: bool,
 }
 
@@ -235,6 +236,7 @@ pub fn fit_stage2(
                     let motion = pass.prior.then_some(&scaled);
                     band_loss.add(losses.evaluate(&LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion }));
                 }
+                // A band counts once; with two passes, their losses are summed.
                 loss.add(band_loss.sum());
             }
         }
