@@ -4,16 +4,16 @@ mod common;
 
 use common::hci;
 use rslf::geometry::ViewId;
-use rslf::io::{Scene, read_pfm};
+use rslf::io::{Raster, Scene, read_pfm};
 use rslf::pipeline::{PlaneSweepSettings, aperture_weights, plane_sweep, stage1_views};
 
 /// Share of pixels (away from an 8-pixel border) whose disparity is off by more than 0.07 px.
-fn bad_pixels(estimate: &rslf::io::Raster, truth: &rslf::io::Raster) -> f64 {
+fn bad_pixels(estimate: &Raster, truth: &Raster) -> f64 {
     bad_pixels_where(estimate, truth, |_, _| true)
 }
 
 /// As [`bad_pixels`], over the pixels `(x, y)` where `keep` holds.
-fn bad_pixels_where(estimate: &rslf::io::Raster, truth: &rslf::io::Raster, keep: impl Fn(usize, usize) -> bool) -> f64 {
+fn bad_pixels_where(estimate: &Raster, truth: &Raster, keep: impl Fn(usize, usize) -> bool) -> f64 {
     let (w, h) = (truth.width, truth.height);
     let (mut bad, mut n) = (0usize, 0usize);
     for y in 8..h - 8 {
@@ -25,6 +25,15 @@ fn bad_pixels_where(estimate: &rslf::io::Raster, truth: &rslf::io::Raster, keep:
     bad as f64 / n.max(1) as f64
 }
 
+/// BadPix(0.07) of the sweep over the central row, then over the row and the `column` views of
+/// the central column nearest the centre.
+fn row_then_with_column(scene: &Scene, truth: &Raster, settings: &PlaneSweepSettings, column: usize) -> (f64, f64) {
+    let row = scene.central_row_views();
+    let with_column: Vec<ViewId> = row.iter().copied().chain(stage1_views(scene, 0, column)).collect();
+    let sweep = |views: &[ViewId]| bad_pixels(&plane_sweep(scene, views, settings, |_, _| {}).disparity, truth);
+    (sweep(&row), sweep(&with_column))
+}
+
 #[test]
 fn the_central_column_finds_the_disparity_of_horizontal_stripes_the_row_cannot_see() {
     // Stripes that vary along y only: every view of the central row shows the same image
@@ -33,27 +42,25 @@ fn the_central_column_finds_the_disparity_of_horizontal_stripes_the_row_cannot_s
     let d = 0.8;
     common::write_plane_scene_with(dir.path(), 64, 64, 5, d, |_| true, |_, y, ch| (0.5 + 0.3 * (0.7 * y + ch as f64).sin() + 0.1 * (0.23 * y).cos()) as f32);
     let scene = Scene::load(dir.path()).unwrap();
-    let truth = rslf::io::Raster::from_vec(64, 64, 1, vec![d as f32; 64 * 64]).unwrap();
+    let truth = Raster::from_vec(64, 64, 1, vec![d as f32; 64 * 64]).unwrap();
     let settings = PlaneSweepSettings { range: (-2.0, 2.0), step: 0.05, window_radius: 2 };
-    let row = scene.central_row_views();
-    let with_column: Vec<ViewId> = row.iter().copied().chain(stage1_views(&scene, 0, 2)).collect();
-    let alone = bad_pixels(&plane_sweep(&scene, &row, &settings, |_, _| {}).disparity, &truth);
-    let both = bad_pixels(&plane_sweep(&scene, &with_column, &settings, |_, _| {}).disparity, &truth);
+    let (alone, both) = row_then_with_column(&scene, &truth, &settings, 2);
     eprintln!("BadPix(0.07): central row {:.1} %, with two central-column views {:.1} %", 100.0 * alone, 100.0 * both);
     assert!(alone > 0.9, "the row cannot see horizontal stripes move: {alone}");
     assert!(both < 0.01, "two views of the column pin them: {both}");
 }
 
+/// HCI antinous, its ground-truth disparity and sweep settings covering its range.
+fn antinous() -> (Scene, Raster, PlaneSweepSettings) {
+    let dir = hci("antinous");
+    let truth = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
+    (Scene::load(&dir).unwrap(), truth, PlaneSweepSettings { range: (-3.5, 3.0), step: 0.05, window_radius: 2 })
+}
+
 #[test]
 fn on_antinous_the_central_column_does_not_make_the_sweep_worse() {
-    let dir = hci("antinous");
-    let scene = Scene::load(&dir).unwrap();
-    let truth = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
-    let settings = PlaneSweepSettings { range: (-3.5, 3.0), step: 0.05, window_radius: 2 };
-    let row = scene.central_row_views();
-    let with_column: Vec<ViewId> = row.iter().copied().chain(stage1_views(&scene, 0, 8)).collect();
-    let alone = bad_pixels(&plane_sweep(&scene, &row, &settings, |_, _| {}).disparity, &truth);
-    let both = bad_pixels(&plane_sweep(&scene, &with_column, &settings, |_, _| {}).disparity, &truth);
+    let (scene, truth, settings) = antinous();
+    let (alone, both) = row_then_with_column(&scene, &truth, &settings, 8);
     eprintln!("BadPix(0.07): central row {:.1} %, with the central column {:.1} %", 100.0 * alone, 100.0 * both);
     // Measured: 26.6 % and 26.0 %. A statue has few edges the row cannot see move.
     assert!(alone < 0.3, "the row-only sweep the pipeline has always used: {alone}");
@@ -68,10 +75,7 @@ fn on_antinous_the_row_gets_horizontal_edges_wrong_more_often() {
     // that extreme shows it: under 0.2 it is 25.5 % against 26.7 %, as the sweep's 5x5 window
     // mostly holds some texture along the row, and over 0.7 (vertical edges, the statue's
     // outline among them, where disparity jumps) it is 34.9 %.
-    let dir = hci("antinous");
-    let scene = Scene::load(&dir).unwrap();
-    let truth = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
-    let settings = PlaneSweepSettings { range: (-3.5, 3.0), step: 0.05, window_radius: 2 };
+    let (scene, truth, settings) = antinous();
     let estimate = plane_sweep(&scene, &scene.central_row_views(), &settings, |_, _| {}).disparity;
     let weights = aperture_weights(scene.central(), 2, 1e-4);
     let horizontal = |x: usize, y: usize| weights.get(x, y, 0) < 0.05;

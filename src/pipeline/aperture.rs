@@ -12,6 +12,7 @@
 //! the share of its local gradient energy that is horizontal: ~0 on horizontal edges, ~1 on
 //! vertical ones, ~1/2 on texture.
 
+use super::box_filter::window_sums;
 use crate::io::Raster;
 
 /// Per-pixel weights in `[0, 1]` of `image`: `(Sxx + eps/2) / (Sxx + Syy + eps)`, with `Sxx` and
@@ -31,27 +32,9 @@ pub fn aperture_weights(image: &Raster, radius: usize, eps: f32) -> Raster {
             gyy[y * w + x] = gy * gy;
         }
     }
-    let (sxx, syy) = (box_sum(&gxx, w, h, radius), box_sum(&gyy, w, h, radius));
-    let data = sxx.iter().zip(&syy).map(|(&a, &b)| (a + 0.5 * eps) / (a + b + eps)).collect();
+    let (sxx, syy) = (window_sums(&gxx, w, h, radius), window_sums(&gyy, w, h, radius));
+    let data = sxx.iter().zip(&syy).map(|(&(a, _), &(b, _))| (a + 0.5 * eps) / (a + b + eps)).collect();
     Raster { width: w, height: h, channels: 1, data }
-}
-
-/// The sum of `values` (`w x h`) over the window of `radius` around each pixel, clipped at the
-/// borders.
-fn box_sum(values: &[f32], w: usize, h: usize, radius: usize) -> Vec<f32> {
-    let mut rows = vec![0.0f32; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            rows[y * w + x] = (x.saturating_sub(radius)..=(x + radius).min(w - 1)).map(|xx| values[y * w + xx]).sum();
-        }
-    }
-    let mut out = vec![0.0f32; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            out[y * w + x] = (y.saturating_sub(radius)..=(y + radius).min(h - 1)).map(|yy| rows[yy * w + x]).sum();
-        }
-    }
-    out
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! then stage 2 (motion) as it arrives, and the result.
 
 mod aperture;
+mod box_filter;
 mod gaussian_init;
 mod light_field;
 mod plane_sweep;

@@ -15,6 +15,7 @@
 //! the nearest confident pixels left, right, above and below, weighted by inverse distance.
 
 use crate::geometry::ViewId;
+use super::box_filter::box_mean;
 use crate::io::{Raster, Scene};
 use rayon::prelude::*;
 
@@ -72,41 +73,6 @@ fn half_cost(central: &Raster, views: &[((f32, f32), &Raster)], d: f32, out: &mu
             *cost = if n == 0 { f32::INFINITY } else { sum / n as f32 };
         }
     });
-}
-
-/// Mean over a `(2r+1)^2` window, ignoring non-finite entries (`INFINITY` if none is finite).
-fn box_mean(src: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
-    let horizontal = |data: &[f32], out: &mut [(f32, u32)]| {
-        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (x, o) in row.iter_mut().enumerate() {
-                let (lo, hi) = (x.saturating_sub(r), (x + r).min(w - 1));
-                let (mut s, mut n) = (0.0, 0);
-                for v in &data[y * w + lo..=y * w + hi] {
-                    if v.is_finite() {
-                        s += v;
-                        n += 1;
-                    }
-                }
-                *o = (s, n);
-            }
-        });
-    };
-    let mut rows = vec![(0.0f32, 0u32); w * h];
-    horizontal(src, &mut rows);
-    let mut out = vec![0.0f32; w * h];
-    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        let (lo, hi) = (y.saturating_sub(r), (y + r).min(h - 1));
-        for (x, o) in row.iter_mut().enumerate() {
-            let (mut s, mut n) = (0.0, 0);
-            for yy in lo..=hi {
-                let (a, b) = rows[yy * w + x];
-                s += a;
-                n += b;
-            }
-            *o = if n == 0 { f32::INFINITY } else { s / n as f32 };
-        }
-    });
-    out
 }
 
 /// Runs the sweep on `views` (views of the central row and of the central column; others are

@@ -57,7 +57,8 @@ pub fn with_gaussian_groups(plan: Plan, g: &Gaussians, lr: &LearningRates, adam_
 /// each step.
 /// Each step renders the same band of rows in every view (the views of the central row see a
 /// point on the same row, those of the central column within a few rows of it), so that every
-/// step weighs all the disparity cues; bands are taken in turn. `progress(step, total, loss)` is called after each step.
+/// step weighs all the disparity cues; bands are taken in turn. `progress(step, total, loss)` is
+/// called after each step.
 pub fn fit_stage1(
     g: Gaussians,
     scene: &Scene,
