@@ -47,6 +47,24 @@ fn stage_1_takes_cotton_central_row_then_its_central_column_nearest_first() {
 }
 
 #[test]
+fn the_shipped_config_fits_the_central_column_only_without_a_rolling_shutter() {
+    let config = rslf::config::Config::read(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/constant_velocity.toml"))).unwrap();
+    let s1 = &config.stage1;
+    assert_eq!(s1.column_views, None, "the shipped config leaves the choice to the capture");
+    // Cotton is a global-shutter capture: its column bends with no motion, so the fit takes as
+    // many of its views as of the row's.
+    let scene = Scene::load(&hci("cotton")).unwrap();
+    assert!(!scene.is_rolling_shutter());
+    let views = stage1_views(&scene, s1.views, s1.column_views_for(scene.is_rolling_shutter()));
+    let v = |row, col| ViewId { row, col };
+    assert_eq!(views, vec![v(4, 2), v(4, 3), v(4, 4), v(4, 5), v(4, 6), v(2, 4), v(3, 4), v(5, 4), v(6, 4)]);
+    // With a rolling shutter the paper's central row only; a count in the config wins.
+    assert_eq!(s1.column_views_for(true), 0);
+    let explicit = rslf::config::Stage1Config { column_views: Some(0), ..s1.clone() };
+    assert_eq!(explicit.column_views_for(false), 0);
+}
+
+#[test]
 fn the_disparity_sign_of_format_reproduces_antinous_central_view() {
     let dir = hci("antinous");
     let scene = Scene::load(&dir).unwrap();

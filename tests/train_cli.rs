@@ -23,6 +23,8 @@ fn train_recovers_the_disparity_of_a_plane_and_writes_a_format_result() {
     let (ok, stdout, stderr) = rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap(), "--models", models.to_str().unwrap()]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("stage 1 initialisation"), "{stdout}");
+    // A global-shutter capture: the central column is fitted too, as many views as the row's.
+    assert!(stdout.contains("of 5 central-row and 4 central-column views"), "{stdout}");
 
     let disp = read_pfm(&out.join("disparity.pfm")).unwrap();
     assert_eq!((disp.width, disp.height), (w, h));

@@ -66,8 +66,11 @@ pub struct Stage1Config {
     /// parallax the row lacks (the disparity of horizontal edges), but read a point of disparity
     /// `d` in view row `r` at `(r-rc) d` rows from where the central view does, so motion in
     /// those `(r-rc) d` line times bends them slightly: measured in the README, four of them
-    /// halve the static drift but double the error of a pan, so the default is 0.
-    pub column_views: usize,
+    /// halve the static drift but double the error of a pan. Unset, it is 0 on a
+    /// rolling-shutter capture and `views - 1` on a global-shutter one, where nothing bends
+    /// them (see [`Stage1Config::column_views_for`]).
+    #[serde(default)]
+    pub column_views: Option<usize>,
     /// Rows per band: each Adam step renders one band in every view.
     pub band_height: usize,
     /// Disparity search range `[min, max]` of the initial plane sweep, pixels; default: the
@@ -91,13 +94,22 @@ pub struct Stage1Config {
     pub initial_disparity: Option<PathBuf>,
 }
 
+impl Stage1Config {
+    /// The central-column views to fit on a capture with or without a rolling shutter: the
+    /// configured count, else none with a rolling shutter (the paper's central row) and as many
+    /// as the row's off-centre views without one.
+    pub fn column_views_for(&self, rolling_shutter: bool) -> usize {
+        self.column_views.unwrap_or(if rolling_shutter { 0 } else { self.views.saturating_sub(1) })
+    }
+}
+
 impl Default for Stage1Config {
     fn default() -> Self {
         Self {
             gaussians: 20_000,
             iterations: 100,
             views: 5,
-            column_views: 0,
+            column_views: None,
             band_height: 64,
             disparity_range: None,
             disparity_step: 0.05,

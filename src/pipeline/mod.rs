@@ -277,7 +277,7 @@ fn stage1(
     let mut gaussians = set.to_module(device);
     log.lines.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
 
-    let views = stage1_views(scene, config.stage1.views, config.stage1.column_views);
+    let views = stage1_views(scene, config.stage1.views, config.stage1.column_views_for(scene.is_rolling_shutter()));
     let mut curves = Vec::new();
     if config.stage1.iterations > 0 {
         let s = &config.stage1;
@@ -330,7 +330,7 @@ fn stage2(
     let mut views = stage2_views(scene, s.views);
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
-        views.extend(stage1_views(scene, s1.views, s1.column_views));
+        views.extend(stage1_views(scene, s1.views, s1.column_views_for(scene.is_rolling_shutter())));
         let lr = LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
         (lr, s1.adam_epsilon as f32)
     });
@@ -381,7 +381,7 @@ fn stage2(
 fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
     let settings = sweep_settings(config, scene);
     let row_views = scene.central_row_views();
-    let column_views = stage1_views(scene, 0, config.stage1.column_views);
+    let column_views = stage1_views(scene, 0, config.stage1.column_views_for(scene.is_rolling_shutter()));
     let views: Vec<ViewId> = row_views.iter().chain(&column_views).copied().collect();
     let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
     let bar = crate::progress::bar(labels, "stage 1: sweep");
