@@ -75,6 +75,12 @@ pub fn stage1_views(scene: &Scene, row: usize, column: usize) -> Vec<ViewId> {
     on_row
 }
 
+/// How many central-column views stage 1 (sweep and fit) and the joint refinement use on
+/// `scene`: the config's count, else the default for the scene's shutter.
+fn column_views(config: &Config, scene: &Scene) -> usize {
+    config.stage1.column_views_for(scene.is_rolling_shutter())
+}
+
 /// The registries a run draws its loss terms and motion models from. The defaults hold the
 /// built-in ones; add to them to run a config that names terms or models of your own.
 #[derive(Clone, Default)]
@@ -277,7 +283,7 @@ fn stage1(
     let mut gaussians = set.to_module(device);
     log.lines.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
 
-    let views = stage1_views(scene, config.stage1.views, config.stage1.column_views_for(scene.is_rolling_shutter()));
+    let views = stage1_views(scene, config.stage1.views, column_views(config, scene));
     let mut curves = Vec::new();
     if config.stage1.iterations > 0 {
         let s = &config.stage1;
@@ -330,7 +336,7 @@ fn stage2(
     let mut views = stage2_views(scene, s.views);
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
-        views.extend(stage1_views(scene, s1.views, s1.column_views_for(scene.is_rolling_shutter())));
+        views.extend(stage1_views(scene, s1.views, column_views(config, scene)));
         let lr = LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
         (lr, s1.adam_epsilon as f32)
     });
@@ -381,8 +387,8 @@ fn stage2(
 fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
     let settings = sweep_settings(config, scene);
     let row_views = scene.central_row_views();
-    let column_views = stage1_views(scene, 0, config.stage1.column_views_for(scene.is_rolling_shutter()));
-    let views: Vec<ViewId> = row_views.iter().chain(&column_views).copied().collect();
+    let column = stage1_views(scene, 0, column_views(config, scene));
+    let views: Vec<ViewId> = row_views.iter().chain(&column).copied().collect();
     let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
     let bar = crate::progress::bar(labels, "stage 1: sweep");
     let start = Instant::now();
@@ -391,7 +397,7 @@ fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
     log.lines.push(format!(
         "stage 1 initialisation: plane sweep over {} central-row and {} central-column views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
         row_views.len(),
-        column_views.len(),
+        column.len(),
         settings.range.0,
         settings.range.1,
         labels,
