@@ -122,6 +122,35 @@ fn the_suite_spans_static_slow_and_fast_motions_of_the_intended_size() {
     assert!(used.iter().all(|&u| u), "every velocity dimension is exercised: {used:?}");
 }
 
+/// The README's suite table is what `rslf generate --suite --list` prints (a table edited by
+/// hand once lost its velocity column to a search-and-replace).
+#[test]
+fn the_readme_suite_table_is_what_the_generator_lists() {
+    let (ok, stdout, stderr) = rslf(&["generate", "--suite", "--list"]);
+    assert!(ok, "{stderr}");
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let listed: Vec<String> = stdout
+        .lines()
+        .skip(1)
+        .map(|line| {
+            // `name  kind  max shift  S px  omega [..] rad/s  v [..] m/s`
+            let (head, rest) = line.split_once(" max shift ").expect("a suite line");
+            let mut words = head.split_whitespace();
+            let (name, kind) = (words.next().unwrap(), words.next().unwrap());
+            let (shift, rest) = rest.trim_start().split_once(" px  omega ").unwrap();
+            let (omega, rest) = rest.split_once(" rad/s  v ").unwrap();
+            let velocity = rest.trim_end_matches(" m/s");
+            format!("| `{name}` | {kind} | {shift} | {omega} | {velocity} |")
+        })
+        .collect();
+    assert_eq!(listed.len(), 33, "{stdout}");
+    let table: Vec<&str> = readme
+        .lines()
+        .filter(|l| l.starts_with("| `") && ["| static |", "| slow |", "| fast |"].iter().any(|k| l.contains(k)))
+        .collect();
+    assert_eq!(table, listed.iter().map(String::as_str).collect::<Vec<_>>());
+}
+
 #[test]
 fn generate_refuses_bad_descriptions_and_existing_folders_cleanly() {
     let dir = tempdir();
