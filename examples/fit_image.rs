@@ -61,7 +61,7 @@ fn fit(image: &Raster, n: usize, iterations: usize) -> Outcome {
     let psnr_before_db = psnr_db(&render_image(&start, w, h, &settings, &device), image, &region);
 
     let losses = LossRegistry::default()
-        .build(&[LossConfig { kind: "l1".into(), weight: 0.8 }, LossConfig { kind: "dssim".into(), weight: 0.2 }])
+        .build(&[LossConfig::new("l1", 0.8), LossConfig::new("dssim", 0.2)])
         .expect("built-in terms");
     let lr = LearningRates { position: 0.2, disparity: 0.0, size: 0.02, colour: 0.02 };
     let default = GroupPlan { schedule: Schedule::Constant(0.0), adam_epsilon: 1e-8 };

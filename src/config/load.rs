@@ -151,6 +151,12 @@ impl Config {
             if !term.weight.is_finite() || term.weight < 0.0 {
                 return Err((format!("loss[{i}].weight"), "must be a finite number >= 0".into()));
             }
+            if let Some(stages) = &term.stages {
+                let valid = !stages.is_empty() && stages.iter().all(|s| matches!(s, 1 | 2)) && !(stages.len() == 2 && stages[0] == stages[1]);
+                if !valid || stages.len() > 2 {
+                    return Err((format!("loss[{i}].stages"), "must list stage 1, stage 2 or both, e.g. [2]".into()));
+                }
+            }
         }
         Ok(())
     }
@@ -172,6 +178,14 @@ mod tests {
         assert_eq!(c.motion.model, "constant_velocity");
         let kinds: Vec<&str> = c.loss.iter().map(|l| l.kind.as_str()).collect();
         assert_eq!(kinds, vec!["l1", "smoothness", "motion_prior"]);
+    }
+
+    #[test]
+    fn a_loss_term_counts_in_the_stages_it_lists_and_in_every_stage_without_a_list() {
+        let c = parse("[[loss]]\nkind = \"l1\"\n\n[[loss]]\nkind = \"dssim\"\nweight = 0.2\nstages = [2]\n\n[[loss]]\nkind = \"smoothness\"\nstages = [1, 2]\n").unwrap();
+        let kinds = |stage| c.losses_in(stage).into_iter().map(|l| l.kind).collect::<Vec<_>>();
+        assert_eq!(kinds(1), ["l1", "smoothness"]);
+        assert_eq!(kinds(2), ["l1", "dssim", "smoothness"]);
     }
 
     #[test]
@@ -197,6 +211,10 @@ mod tests {
     fn ranges_are_checked() {
         let err = parse("[[loss]]\nkind = \"l1\"\nweight = -1.0\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("loss[0].weight"));
+        for bad in ["[]", "[3]", "[2, 2]", "[1, 2, 1]"] {
+            let err = parse(&format!("[[loss]]\nkind = \"l1\"\nstages = {bad}\n")).unwrap_err();
+            assert_eq!(err.key.as_deref(), Some("loss[0].stages"), "{bad}");
+        }
         let err = parse("[stage2]\ndisocclusion_margin = 1000\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.disocclusion_margin"));
     }

@@ -65,7 +65,7 @@ pub struct Stage1Config {
     /// the central view first (0 = the paper's central row only). They hold the vertical
     /// parallax the row lacks (the disparity of horizontal edges), but read a point of disparity
     /// `d` in view row `r` at `(r-rc) d` rows from where the central view does, so motion in
-    /// those `(r-rc) d` line times bends them slightly: measured in the README, four of them
+    /// those `(r-rc) d` line times bends them slightly: measured in docs/results.md, four of them
     /// halve the static drift but double the error of a pan. Unset, it is 0 on a
     /// rolling-shutter capture and `views - 1` on a global-shutter one, where nothing bends
     /// them (see [`Stage1Config::column_views_for`]).
@@ -92,6 +92,13 @@ pub struct Stage1Config {
     /// A disparity map (PFM, the central view's size) to start from instead of the plane sweep,
     /// e.g. another method's estimate, or the ground truth for an ablation.
     pub initial_disparity: Option<PathBuf>,
+}
+
+impl Config {
+    /// The loss terms that count in `stage` (1 or 2), in config order.
+    pub fn losses_in(&self, stage: u8) -> Vec<LossConfig> {
+        self.loss.iter().filter(|l| l.applies_in(stage)).cloned().collect()
+    }
 }
 
 impl Stage1Config {
@@ -251,6 +258,21 @@ pub struct LossConfig {
     /// Weight of the term in the total loss.
     #[serde(default = "one")]
     pub weight: f64,
+    /// The stages the term counts in (`[1]`, `[2]` or `[1, 2]`); unset, every stage.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stages: Option<Vec<u8>>,
+}
+
+impl LossConfig {
+    /// The term `kind` at `weight`, in every stage.
+    pub fn new(kind: &str, weight: f64) -> Self {
+        Self { kind: kind.into(), weight, stages: None }
+    }
+
+    /// Whether the term counts in `stage` (1 or 2).
+    pub fn applies_in(&self, stage: u8) -> bool {
+        self.stages.as_ref().is_none_or(|s| s.contains(&stage))
+    }
 }
 
 fn one() -> f64 {
@@ -263,9 +285,9 @@ fn one() -> f64 {
 /// a static scene still: at 256 px, 1.88 px of drift without it, 0.47 px with it).
 fn default_losses() -> Vec<LossConfig> {
     vec![
-        LossConfig { kind: "l1".into(), weight: 1.0 },
-        LossConfig { kind: "smoothness".into(), weight: 0.05 },
-        LossConfig { kind: "motion_prior".into(), weight: 3e-5 },
+        LossConfig::new("l1", 1.0),
+        LossConfig::new("smoothness", 0.05),
+        LossConfig::new("motion_prior", 3e-5),
     ]
 }
 

@@ -65,12 +65,12 @@ fn the_registry_builds_what_a_config_lists_and_names_what_it_lacks() {
     use crate::config::LossConfig;
     let registry = LossRegistry::default();
     assert_eq!(registry.names(), vec!["dssim", "l1", "l2", "motion_prior", "smoothness"]);
-    let built = registry.build(&[LossConfig { kind: "l2".into(), weight: 2.0 }, LossConfig { kind: "l1".into(), weight: 0.5 }]).unwrap();
+    let built = registry.build(&[LossConfig::new("l2", 2.0), LossConfig::new("l1", 0.5)]).unwrap();
     let device = Device::flex();
     let t = band(vec![0.0; 4], 2, 2, &device);
     let out = output(band(vec![0.2; 4], 2, 2, &device), vec![0.0; 4], &device);
     let total = built.evaluate(&LossInput { rendered: &out, target: &t, rows: 2, width: 2, motion: None }).unwrap().into_scalar::<f32>();
     assert!((total - (2.0 * 0.04 + 0.5 * 0.2)).abs() < 1e-6, "{total}");
-    let err = registry.build(&[LossConfig { kind: "perceptual".into(), weight: 1.0 }]).err().unwrap().to_string();
+    let err = registry.build(&[LossConfig::new("perceptual", 1.0)]).err().unwrap().to_string();
     assert!(err.contains("perceptual") && err.contains("smoothness"), "{err}");
 }

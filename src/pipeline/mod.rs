@@ -185,7 +185,8 @@ pub fn run(config: &Config, scene: &Scene, device: &Device) -> crate::Result<(Ru
 /// Runs the pipeline with loss terms and motion models drawn from `registries`.
 pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Registries) -> crate::Result<(RunResult, RunLog)> {
     let usage = |e: &dyn std::fmt::Display| crate::Error::Usage(format!("config: {e}"));
-    let losses = registries.losses.build(&config.loss).map_err(|e| usage(&e))?;
+    let losses = |stage| registries.losses.build(&config.losses_in(stage)).map_err(|e| usage(&e));
+    let (stage1_losses, stage2_losses) = (losses(1)?, losses(2)?);
     let camera = scene.camera();
     let motion_model = match &camera {
         Some(cam) => {
@@ -195,7 +196,7 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
         None => None,
     };
     let mut log = RunLog::default();
-    let (gaussians, initial, mut curves) = stage1(config, scene, &losses, device, &mut log)?;
+    let (gaussians, initial, mut curves) = stage1(config, scene, &stage1_losses, device, &mut log)?;
     let render = render_settings(config);
 
     let initial_motion = match &config.stage2.initial_motion {
@@ -219,7 +220,7 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
             let stage1_disparity =
                 config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
             let fitted =
-                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &losses, device, stage1_disparity.as_ref(), &mut log);
+                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &stage2_losses, device, stage1_disparity.as_ref(), &mut log);
             let gaussians = fitted.gaussians.clone();
             let (central, disparity, shape) =
                 render_compensated_central(&gaussians, scene, cam, model.as_ref(), &fitted.parameters, &render, &initial, device);
@@ -362,7 +363,7 @@ fn stage2(
     });
     bar.finish_and_clear();
     log.lines.push(format!(
-        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}, loss {:.4} -> {:.4}, {:.1} s",
+        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}, loss ({}) {:.4} -> {:.4}, {:.1} s",
         model.name(),
         s.iterations,
         s.bands_per_step,
@@ -375,6 +376,7 @@ fn stage2(
             "every pixel compared".to_string()
         },
         if fit.aperture_weighting { ", off-row pixels weighted by their horizontal gradient share" } else { "" },
+        losses.names().join(" + "),
         fitted.curve.first().copied().unwrap_or(f32::NAN),
         fitted.curve.last().copied().unwrap_or(f32::NAN),
         start.elapsed().as_secs_f64()
