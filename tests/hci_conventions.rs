@@ -51,8 +51,8 @@ fn the_shipped_config_fits_the_central_column_only_without_a_rolling_shutter() {
     let config = rslf::config::Config::read(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/constant_velocity.toml"))).unwrap();
     let s1 = &config.stage1;
     assert_eq!(s1.column_views, None, "the shipped config leaves the choice to the capture");
-    // Cotton is a global-shutter capture: its column bends with no motion, so the fit takes as
-    // many of its views as of the row's.
+    // Cotton is a global-shutter capture: no motion bends its column, so the fit takes as many
+    // of its views as of the row's.
     let scene = Scene::load(&hci("cotton")).unwrap();
     assert!(!scene.is_rolling_shutter());
     let views = stage1_views(&scene, s1.views, s1.column_views_for(scene.is_rolling_shutter()));

@@ -152,8 +152,9 @@ impl Config {
                 return Err((format!("loss[{i}].weight"), "must be a finite number >= 0".into()));
             }
             if let Some(stages) = &term.stages {
-                let valid = !stages.is_empty() && stages.iter().all(|s| matches!(s, 1 | 2)) && !(stages.len() == 2 && stages[0] == stages[1]);
-                if !valid || stages.len() > 2 {
+                // One or two stages out of {1, 2}, none twice.
+                let valid = matches!(stages.len(), 1 | 2) && stages.iter().all(|s| matches!(s, 1 | 2)) && stages.first() != stages.get(1);
+                if !valid {
                     return Err((format!("loss[{i}].stages"), "must list stage 1, stage 2 or both, e.g. [2]".into()));
                 }
             }
