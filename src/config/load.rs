@@ -138,6 +138,9 @@ impl Config {
         if self.stage2.disocclusion_margin > 32 {
             return fail("stage2.disocclusion_margin", "must be at most 32 pixels");
         }
+        if !(self.stage2.cue_weight >= 0.0 && self.stage2.cue_weight.is_finite()) {
+            return fail("stage2.cue_weight", "must be a finite number >= 0");
+        }
         if self.motion.model.is_empty() {
             return fail("motion.model", "must name a motion model");
         }
@@ -218,5 +221,7 @@ mod tests {
         }
         let err = parse("[stage2]\ndisocclusion_margin = 1000\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.disocclusion_margin"));
+        let err = parse("[stage2]\ncue_weight = -0.5\n").unwrap_err();
+        assert_eq!(err.key.as_deref(), Some("stage2.cue_weight"));
     }
 }

@@ -5,20 +5,26 @@ mod aperture;
 mod box_filter;
 mod gaussian_init;
 mod light_field;
+mod cue_term;
+mod measured_cues;
 mod plane_sweep;
 mod results;
 mod stage1_fit;
 mod stage2_fit;
 mod targets;
+mod view_tracking;
 mod visibility;
 
 pub use aperture::aperture_weights;
 pub use gaussian_init::{frequency_map, sample_gaussians};
+pub use cue_term::CueTerm;
+pub use measured_cues::{Cue, measure_cues, predicted_cue};
 pub use light_field::{Moment, motion_of_record, render_light_field};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{PointCloud, RunResult, depth_map};
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
 pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales};
+pub use view_tracking::{Track, TrackSettings, textured_points, track};
 pub use visibility::explained_mask;
 
 use crate::config::{Config, TimingChoice, ViewSelection};
@@ -30,6 +36,9 @@ use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
 use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, splat};
 use burn::tensor::{Device, Tensor, TensorData};
 use std::time::Instant;
+
+/// Residual (px) beyond which a measured cue counts linearly in the cue term.
+const CUE_HUBER_PX: f32 = 0.1;
 
 /// Opacity above which a rendered pixel's blended disparity is trusted over the initial map.
 const TRUSTED_ALPHA: f32 = 0.5;
@@ -220,7 +229,7 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
             let stage1_disparity =
                 config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
             let fitted =
-                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &stage2_losses, device, stage1_disparity.as_ref(), &mut log);
+                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &stage2_losses, device, stage1_disparity.as_ref(), &initial, &mut log);
             let gaussians = fitted.gaussians.clone();
             let (central, disparity, shape) =
                 render_compensated_central(&gaussians, scene, cam, model.as_ref(), &fitted.parameters, &render, &initial, device);
@@ -331,9 +340,20 @@ fn stage2(
     losses: &WeightedLosses,
     device: &Device,
     stage1_disparity: Option<&Raster>,
+    initial_disparity: &Raster,
     log: &mut RunLog,
 ) -> MotionFit {
     let s = &config.stage2;
+    let cue_term = (s.cue_weight > 0.0).then(|| {
+        let start = Instant::now();
+        let cues = measure_cues(scene, initial_disparity);
+        log.lines.push(format!(
+            "stage 2 cues: {} textured patches tracked from the central-row views of the corners' columns into the central view and the corners, {:.1} s",
+            cues.len(),
+            start.elapsed().as_secs_f64()
+        ));
+        CueTerm::new(&cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, device)
+    });
     let mut views = stage2_views(scene, s.views);
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
@@ -357,13 +377,13 @@ fn stage2(
     };
     let bar = crate::progress::bar(s.iterations as u64, "stage 2: motion");
     let start = Instant::now();
-    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, stage1_disparity, |done, _, loss| {
+    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, stage1_disparity, cue_term.as_ref(), |done, _, loss| {
         bar.set_position(done as u64);
         bar.set_message(format!("stage 2: loss {loss:.4}"));
     });
     bar.finish_and_clear();
     log.lines.push(format!(
-        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}, loss ({}) {:.4} -> {:.4}, {:.1} s",
+        "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4}, {:.1} s",
         model.name(),
         s.iterations,
         s.bands_per_step,
@@ -376,6 +396,7 @@ fn stage2(
             "every pixel compared".to_string()
         },
         if fit.aperture_weighting { ", off-row pixels weighted by their horizontal gradient share" } else { "" },
+        cue_term.as_ref().map_or(String::new(), |c| format!(", measured-cue term ×{} over {} cues", c.weight, c.len)),
         losses.names().join(" + "),
         fitted.curve.first().copied().unwrap_or(f32::NAN),
         fitted.curve.last().copied().unwrap_or(f32::NAN),

@@ -3,6 +3,7 @@
 //! rolling shutter into each view and compares a stratified sample of row bands.
 
 use super::aperture::aperture_weights;
+use super::cue_term::CueTerm;
 use super::targets::{ViewTarget, band_tensor, view_targets};
 use super::visibility::{explained_mask_moving, masked};
 use crate::geometry::{Camera, TensorCamera, ViewId};
@@ -144,6 +145,7 @@ pub fn fit_stage2(
     losses: &WeightedLosses,
     device: &Device,
     central_disparity: Option<&Raster>,
+    cues: Option<&CueTerm>,
     mut progress: impl FnMut(usize, usize, f32),
 ) -> MotionFit {
     let g = if fit.refine.is_some() { g } else { g.no_grad() };
@@ -240,7 +242,11 @@ pub fn fit_stage2(
                 loss.add(band_loss.sum());
             }
         }
-        loss.mean()
+        let photometric = loss.mean();
+        match cues {
+            Some(cues) => photometric.map(|l| l + cues.evaluate(tc, model, params.clone())),
+            None => photometric,
+        }
     };
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
     let kept = masks.map_or(1.0, |(kept, _)| kept);

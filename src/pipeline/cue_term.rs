@@ -1,0 +1,104 @@
+//! The measured cues as a term of the stage-2 objective: how far the cues the current motion
+//! predicts lie from those tracked between the views ([`super::measured_cues`]).
+//!
+//! Each cue's point (its central-view position and measured disparity, the scene at its row's
+//! read-out time) is moved back to t = 0 under the motion and re-imaged, each at its own row's
+//! time, into its corner view: the same tensor program that places the Gaussians, so the
+//! gradient with respect to the motion comes from the framework. The term is the mean Huber
+//! penalty of the difference, in pixels.
+
+use super::measured_cues::Cue;
+use crate::geometry::{Camera, TensorCamera};
+use crate::model::GaussianSet;
+use crate::model::motion::MotionModel;
+use crate::render::StaticShape;
+use burn::module::Module;
+use burn::tensor::{Device, Tensor, TensorData};
+
+/// The measured cues of one corner view, as tensors.
+struct CornerCues {
+    /// The cue points as zero-size Gaussians of the central view (no gradient).
+    points: crate::model::Gaussians,
+    /// The view offset `(c - cc, r - rc)`.
+    offset: (f32, f32),
+    /// Where no motion puts each point in the view, plus its measured cue: `[N]` each way.
+    target_u: Tensor<1>,
+    target_v: Tensor<1>,
+}
+
+/// The measured-cue term of stage 2.
+pub struct CueTerm {
+    corners: Vec<CornerCues>,
+    /// Its weight in the objective.
+    pub weight: f32,
+    /// The Huber threshold (px): residuals beyond it count linearly.
+    pub huber_px: f32,
+    /// Fixed-point iterations of each point's read-out time.
+    pub timing_iterations: usize,
+    /// Number of cues.
+    pub len: usize,
+}
+
+impl CueTerm {
+    /// The term for `cues` of a scene seen by `camera`, on `device`.
+    pub fn new(cues: &[Cue], camera: &Camera, weight: f32, huber_px: f32, timing_iterations: usize, device: &Device) -> Self {
+        let mut views: Vec<_> = cues.iter().map(|c| c.view).collect();
+        views.sort();
+        views.dedup();
+        let corners = views
+            .into_iter()
+            .map(|view| {
+                let mine: Vec<&Cue> = cues.iter().filter(|c| c.view == view).collect();
+                let n = mine.len();
+                let set = GaussianSet {
+                    u: mine.iter().map(|c| c.at.0 as f32).collect(),
+                    v: mine.iter().map(|c| c.at.1 as f32).collect(),
+                    disparity: mine.iter().map(|c| c.disparity as f32).collect(),
+                    size: vec![1.0; n],
+                    colour: vec![0.0; n],
+                    channels: 1,
+                };
+                let still: Vec<(f64, f64)> =
+                    mine.iter().map(|c| camera.grid.position_in_view(view, c.at.0, c.at.1, c.disparity)).collect();
+                let target = |k: usize| {
+                    let data: Vec<f32> = mine
+                        .iter()
+                        .zip(&still)
+                        .map(|(c, s)| if k == 0 { (s.0 + c.offset.0) as f32 } else { (s.1 + c.offset.1) as f32 })
+                        .collect();
+                    Tensor::<1>::from_data(TensorData::new(data, [n]), device)
+                };
+                let (a, b) = camera.grid.offset(view);
+                CornerCues { points: set.to_module(device).no_grad(), offset: (a as f32, b as f32), target_u: target(0), target_v: target(1) }
+            })
+            .collect();
+        Self { corners, weight, huber_px, timing_iterations, len: cues.len() }
+    }
+
+    /// The weighted mean Huber penalty of the cues predicted by `model` at `params` (SI) against
+    /// the measured ones: a one-element tensor.
+    pub fn evaluate(&self, camera: TensorCamera, model: &dyn MotionModel, params: Tensor<1>) -> Tensor<1> {
+        let mut total: Option<Tensor<1>> = None;
+        for corner in &self.corners {
+            let shape = StaticShape::new(&corner.points, camera, model, params.clone());
+            let splats = shape.splats_rolling(model, params.clone(), corner.offset, self.timing_iterations);
+            let penalty = huber(splats.u - corner.target_u.clone(), self.huber_px) + huber(splats.v - corner.target_v.clone(), self.huber_px);
+            let sum = penalty.sum();
+            total = Some(match total {
+                Some(t) => t + sum,
+                None => sum,
+            });
+        }
+        let device = params.device();
+        total.unwrap_or_else(|| Tensor::zeros([1], &device)) * (self.weight / self.len.max(1) as f32)
+    }
+}
+
+/// Elementwise Huber penalty with threshold `k`: `x²/2` within `k`, `k (|x| - k/2)` beyond.
+fn huber(x: Tensor<1>, k: f32) -> Tensor<1> {
+    let a = x.abs();
+    let inside = a.clone().lower_equal_elem(k);
+    let quadratic = a.clone().powf_scalar(2.0) * 0.5;
+    let linear = (a - k * 0.5) * k;
+    linear.mask_where(inside, quadratic)
+}

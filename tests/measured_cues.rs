@@ -1,0 +1,116 @@
+//! Rolling-shutter cues measured from the views alone: zero on a real still light field (HCI
+//! antinous, whose views are synchronised and whose vertical and horizontal baselines are
+//! equal), the true motion's on a generated moving one, and the stage-2 cue term (a burn tensor
+//! program) agrees with the host prediction it is built from.
+
+mod common;
+
+use burn::tensor::{Device, Tensor, TensorData};
+use common::{hci, tempdir};
+use rslf::config::MotionConfig;
+use rslf::geometry::{TensorCamera, readout_interval};
+use rslf::io::{GroundTruth, MotionRecord, Scene, read_pfm};
+use rslf::model::motion::{MotionRegistry, MotionSetup};
+use rslf::pipeline::{Cue, CueTerm, measure_cues, predicted_cue};
+use rslf::synth::{GenerateOptions, base_scene, generate};
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+#[test]
+fn antinous_corners_sit_where_the_central_row_disparity_puts_them() {
+    let dir = hci("antinous");
+    let scene = Scene::load(&dir).unwrap();
+    let guess = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
+    let cues = measure_cues(&scene, &guess);
+    let (mx, my) = (median(cues.iter().map(|c| c.offset.0.abs()).collect()), median(cues.iter().map(|c| c.offset.1.abs()).collect()));
+    let (sx, sy) = (median(cues.iter().map(|c| c.offset.0).collect()), median(cues.iter().map(|c| c.offset.1).collect()));
+    eprintln!("{} cues; median |offset| {mx:.4} / {my:.4} px, median offset {sx:.4} / {sy:.4} px", cues.len());
+    assert!(cues.len() > 2000, "{} cues", cues.len());
+    // Tracking noise of about 0.08 px (8-bit views at 512 px), centred on zero both ways: the
+    // corners show no motion and their vertical parallax is the row's horizontal one.
+    assert!(mx < 0.15 && my < 0.15, "median |offset| {mx} / {my}");
+    assert!(sx.abs() < 0.01 && sy.abs() < 0.01, "median offset {sx} / {sy}");
+    // Each cue's disparity is the truth's where the patch lies (HCI's disparity sign).
+    let err = median(cues.iter().map(|c| (c.disparity - guess.data[c.at.1 as usize * guess.width + c.at.0.round() as usize] as f64).abs()).collect());
+    assert!(err < 0.05, "median disparity error {err}");
+}
+
+/// The objects scene at 256 px (a 9x9 grid) under `motion`, written to a temporary folder.
+fn moving_objects(motion: &MotionRecord) -> (common::TempDir, Scene) {
+    let dir = tempdir();
+    let mut desc = base_scene("objects").unwrap();
+    desc.motion = Some(toml::from_str(&motion.to_toml_string()).unwrap());
+    let options = GenerateOptions { size: Some([256, 256]), seed: 0 };
+    generate(&desc, &options, |_, _| {}).unwrap().write(&dir.path().join("s"), false).unwrap();
+    let scene = Scene::load(&dir.path().join("s")).unwrap();
+    (dir, scene)
+}
+
+#[test]
+fn a_pan_shows_in_the_measured_cues_as_its_motion_predicts_them() {
+    let truth = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.3, 0.0], velocity_m_s: [0.0, 0.0, 0.0] };
+    let (_dir, scene) = moving_objects(&truth);
+    let camera = scene.camera().unwrap();
+    let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
+    let cues = measure_cues(&scene, gt.disparity.as_ref().unwrap());
+    assert!(cues.len() > 2000, "{} cues", cues.len());
+    let pairs: Vec<((f64, f64), (f64, f64))> = cues.iter().filter_map(|c| predicted_cue(&camera, &truth, c).map(|p| (c.offset, p))).collect();
+    let miss = |f: &dyn Fn(&(f64, f64)) -> (f64, f64)| median(pairs.iter().map(|(m, p)| (m.0 - f(p).0).hypot(m.1 - f(p).1)).collect());
+    let (with_truth, with_none) = (miss(&|p| *p), miss(&|_| (0.0, 0.0)));
+    eprintln!("{} cues; median miss {with_truth:.4} px with the true motion, {with_none:.4} px with none", pairs.len());
+    assert!(with_truth < 0.75 * with_none, "{with_truth} against {with_none}");
+    // Least squares over the cues the truth explains to within 0.3 px: the measured cues are the
+    // predicted ones, not a fraction or a multiple of them.
+    let (num, den) = pairs
+        .iter()
+        .filter(|(m, p)| (m.0 - p.0).hypot(m.1 - p.1) < 0.3)
+        .fold((0.0, 0.0), |(n, d), (m, p)| (n + m.0 * p.0 + m.1 * p.1, d + p.0 * p.0 + p.1 * p.1));
+    assert!((num / den - 1.0).abs() < 0.1, "share {}", num / den);
+}
+
+#[test]
+fn the_cue_term_is_zero_at_the_motion_its_cues_were_predicted_from() {
+    let camera = rslf::geometry::Camera {
+        grid: rslf::geometry::ViewGrid { rows: 9, cols: 9 },
+        width: 128,
+        height: 96,
+        f_px: 180.0,
+        baseline_m: 0.03,
+        focus_m: 3.0,
+        line_time_s: 3e-4,
+    };
+    let truth = MotionRecord::ConstantVelocity { omega_rad_s: [0.1, -0.3, 0.2], velocity_m_s: [0.4, -0.1, 0.3] };
+    // Cues on a grid of the central view at assorted disparities, with the offsets the host
+    // projection gives under `truth`.
+    let cues: Vec<Cue> = camera
+        .grid
+        .corners()
+        .into_iter()
+        .flat_map(|view| (0..40).map(move |i| (view, i)))
+        .filter_map(|(view, i)| {
+            let at = (10.0 + (i % 8) as f64 * 13.0, 8.0 + (i / 8) as f64 * 17.0);
+            let mut cue = Cue { at, disparity: -1.0 + 0.11 * i as f64, view, offset: (0.0, 0.0) };
+            cue.offset = predicted_cue(&camera, &truth, &cue)?;
+            Some(cue)
+        })
+        .collect();
+    assert_eq!(cues.len(), 160);
+    assert!(cues.iter().any(|c| c.offset.0.hypot(c.offset.1) > 0.05), "the motion moves the cues");
+    let device = Device::flex();
+    let setup = MotionSetup { readout: readout_interval(camera.height, camera.line_time_s) };
+    let model = MotionRegistry::default().build(&MotionConfig { model: "constant_velocity".into(), segments: 1 }, &setup).unwrap();
+    let term = CueTerm::new(&cues, &camera, 1.0, 0.1, 3, &device);
+    let value = |record: &MotionRecord| {
+        let params: Vec<f32> = model.parameters_of(record).unwrap().iter().map(|&x| x as f32).collect();
+        let n = params.len();
+        let t: Tensor<1> = term.evaluate(TensorCamera::new(&camera), model.as_ref(), Tensor::from_data(TensorData::new(params, [n]), &device));
+        t.into_scalar::<f32>() as f64
+    };
+    let (at_truth, at_zero) = (value(&truth), value(&MotionRecord::zero()));
+    eprintln!("cue term {at_truth:.3e} at the truth, {at_zero:.3e} with no motion");
+    assert!(at_truth < 1e-6, "{at_truth}");
+    assert!(at_zero > 1e-3, "{at_zero}");
+}
