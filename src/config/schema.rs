@@ -191,11 +191,11 @@ pub struct Stage2Config {
     /// row cannot fix, and whose vertical displacement a disparity error imitates exactly) do not
     /// bend the motion. Under joint refinement the Gaussians still compare every pixel.
     pub aperture_weighting: bool,
-    /// Weight of the measured-cue term (0 = off): textured patches of the central view are
-    /// tracked into each compared corner and into the central-row view of its column, which
-    /// measures, with no scene model, how far the motion moved each from where its disparity
-    /// alone puts it; the term is the mean Huber penalty (px) of the motion's predicted cues
-    /// against those.
+    /// Weight of the measured-cue term (0 = off): textured patches of the central-row view of
+    /// each corner's column are tracked into the central view (their disparity) and into the
+    /// corner, which measures, with no scene model, how far the motion moved each from where its
+    /// disparity alone puts it; the term is the mean Huber penalty (px) of the motion's
+    /// predicted cues against those.
     pub cue_weight: f64,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.

@@ -13,6 +13,7 @@ use crate::model::GaussianSet;
 use crate::model::motion::MotionModel;
 use crate::render::StaticShape;
 use burn::module::Module;
+use burn::nn::loss::{HuberLoss, HuberLossConfig};
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// The measured cues of one corner view, as tensors.
@@ -31,8 +32,8 @@ pub struct CueTerm {
     corners: Vec<CornerCues>,
     /// Its weight in the objective.
     pub weight: f32,
-    /// The Huber threshold (px): residuals beyond it count linearly.
-    pub huber_px: f32,
+    /// The penalty: quadratic within its threshold (px), linear beyond.
+    huber: HuberLoss,
     /// Fixed-point iterations of each point's read-out time.
     pub timing_iterations: usize,
     /// Number of cues.
@@ -72,7 +73,7 @@ impl CueTerm {
                 CornerCues { points: set.to_module(device).no_grad(), offset: (a as f32, b as f32), target_u: target(0), target_v: target(1) }
             })
             .collect();
-        Self { corners, weight, huber_px, timing_iterations, len: cues.len() }
+        Self { corners, weight, huber: HuberLossConfig::new(huber_px).init(), timing_iterations, len: cues.len() }
     }
 
     /// The weighted mean Huber penalty of the cues predicted by `model` at `params` (SI) against
@@ -82,8 +83,8 @@ impl CueTerm {
         for corner in &self.corners {
             let shape = StaticShape::new(&corner.points, camera, model, params.clone());
             let splats = shape.splats_rolling(model, params.clone(), corner.offset, self.timing_iterations);
-            let penalty = huber(splats.u - corner.target_u.clone(), self.huber_px) + huber(splats.v - corner.target_v.clone(), self.huber_px);
-            let sum = penalty.sum();
+            let sum = self.huber.forward_no_reduction(splats.u, corner.target_u.clone()).sum()
+                + self.huber.forward_no_reduction(splats.v, corner.target_v.clone()).sum();
             total = Some(match total {
                 Some(t) => t + sum,
                 None => sum,
@@ -92,13 +93,4 @@ impl CueTerm {
         let device = params.device();
         total.unwrap_or_else(|| Tensor::zeros([1], &device)) * (self.weight / self.len.max(1) as f32)
     }
-}
-
-/// Elementwise Huber penalty with threshold `k`: `x²/2` within `k`, `k (|x| - k/2)` beyond.
-fn huber(x: Tensor<1>, k: f32) -> Tensor<1> {
-    let a = x.abs();
-    let inside = a.clone().lower_equal_elem(k);
-    let quadratic = a.clone().powf_scalar(2.0) * 0.5;
-    let linear = (a - k * 0.5) * k;
-    linear.mask_where(inside, quadratic)
 }

@@ -44,16 +44,21 @@ pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
     let central = scene.central().to_grey();
     let stride = ((w * h) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
     let mut cues = Vec::new();
-    for corner in grid.corners() {
-        let column_view = ViewId { row: centre.row, col: corner.col };
-        let (Some(corner_img), Some(row_img)) = (scene.view(corner), scene.view(column_view)) else { continue };
-        let (corner_img, row_img) = (corner_img.to_grey(), row_img.to_grey());
-        let (a, b) = grid.offset(corner);
-        if a == 0.0 {
+    // The corners two by two, by column: both are tracked from the same row view.
+    let mut columns: Vec<usize> = grid.corners().iter().map(|c| c.col).collect();
+    columns.sort();
+    columns.dedup();
+    for col in columns {
+        let corners: Vec<(ViewId, Raster)> =
+            grid.corners().into_iter().filter(|c| c.col == col).filter_map(|c| Some((c, scene.view(c)?.to_grey()))).collect();
+        let Some(row_img) = scene.view(ViewId { row: centre.row, col }) else { continue };
+        let a = grid.offset(ViewId { row: centre.row, col }).0;
+        if a == 0.0 || corners.is_empty() {
             continue;
         }
+        let row_img = row_img.to_grey();
         let points = textured_points(&row_img, settings.radius, stride, 0.1);
-        let found: Vec<Cue> = points
+        let found: Vec<Vec<Cue>> = points
             .par_iter()
             .filter_map(|&(x, y)| {
                 let gx = ((x as f64 + a * guess_d0(guess, x, y)?).round().max(0.0) as usize).min(w - 1);
@@ -64,13 +69,16 @@ pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
                     return None;
                 }
                 let d = to_centre.displacement.0 / a;
-                // The same patch in the corner of its column: `b d` rows up or down, and `μ`.
-                let in_corner = track(&row_img, &corner_img, (x, y), (0.0, -b * d), &settings)?;
-                let (dx, dy) = in_corner.displacement;
-                Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: corner, offset: (dx, dy + b * d) })
+                // The same patch in each corner of its column: `b d` rows up or down, and `μ`.
+                let in_corners = corners.iter().filter_map(|(view, image)| {
+                    let b = grid.offset(*view).1;
+                    let (dx, dy) = track(&row_img, image, (x, y), (0.0, -b * d), &settings)?.displacement;
+                    Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d) })
+                });
+                Some(in_corners.collect())
             })
             .collect();
-        cues.extend(found);
+        cues.extend(found.into_iter().flatten());
     }
     cues
 }

@@ -3,9 +3,9 @@
 
 mod aperture;
 mod box_filter;
+mod cue_term;
 mod gaussian_init;
 mod light_field;
-mod cue_term;
 mod measured_cues;
 mod plane_sweep;
 mod results;
@@ -16,10 +16,10 @@ mod view_tracking;
 mod visibility;
 
 pub use aperture::aperture_weights;
-pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use cue_term::CueTerm;
-pub use measured_cues::{Cue, measure_cues, predicted_cue};
+pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
+pub use measured_cues::{Cue, measure_cues, predicted_cue};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{PointCloud, RunResult, depth_map};
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};

@@ -33,26 +33,27 @@ pub struct Track {
     pub residual_rms: f64,
 }
 
-/// The structure tensor `(Σ gx², Σ gx gy, Σ gy²)` of the grey image `grey` over the patch of
-/// half-size `radius` centred on the integer pixel (`x`, `y`), with central differences; `None`
-/// when the patch (with its one-pixel rim) leaves the image.
-fn structure_tensor(grey: &Raster, x: usize, y: usize, radius: usize) -> Option<(f64, f64, f64)> {
+/// The pixels of the patch of half-size `radius` centred on the integer pixel (`x`, `y`) of the
+/// grey image `grey`, row by row: `(dx, dy, value, gx, gy)`, with the offset from the centre and
+/// central-difference gradients; `None` when the patch (with its one-pixel rim) leaves the image.
+fn patch(grey: &Raster, x: usize, y: usize, radius: usize) -> Option<impl Iterator<Item = (f64, f64, f64, f64, f64)> + '_> {
     let (w, h) = (grey.width, grey.height);
     if x < radius + 1 || y < radius + 1 || x + radius + 1 >= w || y + radius + 1 >= h {
         return None;
     }
-    let at = |x: usize, y: usize| grey.data[y * w + x] as f64;
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for yy in y - radius..=y + radius {
-        for xx in x - radius..=x + radius {
+    let at = move |x: usize, y: usize| grey.data[y * w + x] as f64;
+    Some((y - radius..=y + radius).flat_map(move |yy| {
+        (x - radius..=x + radius).map(move |xx| {
             let gx = 0.5 * (at(xx + 1, yy) - at(xx - 1, yy));
             let gy = 0.5 * (at(xx, yy + 1) - at(xx, yy - 1));
-            sxx += gx * gx;
-            sxy += gx * gy;
-            syy += gy * gy;
-        }
-    }
-    Some((sxx, sxy, syy))
+            (xx as f64 - x as f64, yy as f64 - y as f64, at(xx, yy), gx, gy)
+        })
+    }))
+}
+
+/// The structure tensor `(Σ gx², Σ gx gy, Σ gy²)` of a patch's pixels.
+fn structure_tensor(pixels: impl Iterator<Item = (f64, f64, f64, f64, f64)>) -> (f64, f64, f64) {
+    pixels.fold((0.0, 0.0, 0.0), |(sxx, sxy, syy), (_, _, _, gx, gy)| (sxx + gx * gx, sxy + gx * gy, syy + gy * gy))
 }
 
 /// The smaller eigenvalue of the symmetric 2x2 matrix `[[a, b], [b, c]]`.
@@ -71,7 +72,7 @@ pub fn textured_points(grey: &Raster, radius: usize, stride: usize, share: f64) 
         .step_by(stride)
         .flat_map(|y| (margin..grey.width.saturating_sub(margin)).step_by(stride).map(move |x| (x, y)))
         .filter_map(|(x, y)| {
-            let t = structure_tensor(grey, x, y, radius)?;
+            let t = structure_tensor(patch(grey, x, y, radius)?);
             let small = smaller_eigenvalue(t);
             Some(((x, y), small, t.0 + t.2 - small))
         })
@@ -92,24 +93,16 @@ pub fn textured_points(grey: &Raster, radius: usize, stride: usize, share: f64) 
 /// from the guess.
 pub fn track(from: &Raster, to: &Raster, at: (usize, usize), guess: (f64, f64), settings: &TrackSettings) -> Option<Track> {
     let r = settings.radius;
-    let (x0, y0) = at;
-    let (sxx, sxy, syy) = structure_tensor(from, x0, y0, r)?;
-    let det = sxx * syy - sxy * sxy;
-    if det <= 1e-18 * (sxx + syy).powi(2).max(1e-30) {
-        return None;
-    }
     if (from.width, from.height) != (to.width, to.height) {
         return None;
     }
-    let value = |img: &Raster, x: usize, y: usize| img.data[y * img.width + x] as f64;
-    // The template and its gradients, row by row over the patch.
-    let mut template = Vec::with_capacity((2 * r + 1).pow(2));
-    for y in y0 - r..=y0 + r {
-        for x in x0 - r..=x0 + r {
-            let gx = 0.5 * (value(from, x + 1, y) - value(from, x - 1, y));
-            let gy = 0.5 * (value(from, x, y + 1) - value(from, x, y - 1));
-            template.push((x as f64 - x0 as f64, y as f64 - y0 as f64, value(from, x, y), gx, gy));
-        }
+    let (x0, y0) = at;
+    // The template and its gradients, whose structure tensor is the Hessian of every step.
+    let template: Vec<_> = patch(from, x0, y0, r)?.collect();
+    let (sxx, sxy, syy) = structure_tensor(template.iter().copied());
+    let det = sxx * syy - sxy * sxy;
+    if det <= 1e-18 * (sxx + syy).powi(2).max(1e-30) {
+        return None;
     }
     let (mut dx, mut dy) = guess;
     for _ in 0..settings.iterations {
