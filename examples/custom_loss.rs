@@ -103,10 +103,7 @@ fn main() -> std::process::ExitCode {
     }
     let o = demo(128, 8000, 150);
     println!("{}", o.log);
-    println!(
-        "objects_static 128x128, BadPix(0.07): {:.2}% with gradient_l1, {:.2}% without",
-        o.with_term, o.without_term
-    );
+    println!("objects_static 128x128, BadPix(0.07): {:.2}% with gradient_l1, {:.2}% without", o.with_term, o.without_term);
     std::process::ExitCode::SUCCESS
 }
 

@@ -61,7 +61,8 @@ fn registries() -> Registries {
 /// Generates `configs/scenes/objects.toml` at `size` px, panning about Y at `omega_y` rad/s.
 fn generate_scene(dir: &Path, size: usize, omega_y: f64) -> Scene {
     let text = include_str!("../configs/scenes/objects.toml");
-    let text = format!("{text}\n[motion]\nmodel = \"constant_velocity\"\nomega_rad_s = [0.0, {omega_y}, 0.0]\nvelocity_m_s = [0.0, 0.0, 0.0]\n");
+    let text =
+        format!("{text}\n[motion]\nmodel = \"constant_velocity\"\nomega_rad_s = [0.0, {omega_y}, 0.0]\nvelocity_m_s = [0.0, 0.0, 0.0]\n");
     let description = SceneDescription::parse(&text, Path::new("objects.toml")).expect("the description parses");
     let options = GenerateOptions { size: Some([size, size]), seed: 0 };
     let scene = generate(&description, &options, |_, _| {}).expect("the scene generates");

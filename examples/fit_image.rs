@@ -6,6 +6,7 @@
 //!
 //! `cargo run --release --example fit_image [-- IMAGE.png]` (default: a generated test image).
 
+use burn::tensor::Device;
 use rslf::config::LossConfig;
 use rslf::eval::psnr_db;
 use rslf::io::{Raster, read_image};
@@ -14,7 +15,6 @@ use rslf::model::Gaussians;
 use rslf::optim::{GroupPlan, Plan, Schedule, Stage, optimise};
 use rslf::pipeline::{LearningRates, image_tensor, sample_gaussians, with_gaussian_groups};
 use rslf::render::{RenderSettings, render_rows};
-use burn::tensor::Device;
 use std::time::Instant;
 
 /// What the fit achieved.
@@ -60,9 +60,7 @@ fn fit(image: &Raster, n: usize, iterations: usize) -> Outcome {
     let region = vec![true; w * h];
     let psnr_before_db = psnr_db(&render_image(&start, w, h, &settings, &device), image, &region);
 
-    let losses = LossRegistry::default()
-        .build(&[LossConfig::new("l1", 0.8), LossConfig::new("dssim", 0.2)])
-        .expect("built-in terms");
+    let losses = LossRegistry::default().build(&[LossConfig::new("l1", 0.8), LossConfig::new("dssim", 0.2)]).expect("built-in terms");
     let lr = LearningRates { position: 0.2, disparity: 0.0, size: 0.02, colour: 0.02 };
     let default = GroupPlan { schedule: Schedule::Constant(0.0), adam_epsilon: 1e-8 };
     let stage = Stage { iterations, plan: with_gaussian_groups(Plan::new(default), &start, &lr, 1e-8) };

@@ -18,9 +18,7 @@ fn main() {
     println!("{}: {}x{} px, {} channel(s)", dir.display(), scene.width(), scene.height(), scene.channels());
     println!("grid {}x{}, {} views present:", scene.grid.rows, scene.grid.cols, scene.present_views().len());
     for r in 0..scene.grid.rows {
-        let row: String = (0..scene.grid.cols)
-            .map(|c| if scene.views[r * scene.grid.cols + c].is_some() { 'o' } else { '.' })
-            .collect();
+        let row: String = (0..scene.grid.cols).map(|c| if scene.views[r * scene.grid.cols + c].is_some() { 'o' } else { '.' }).collect();
         println!("  {row}");
     }
     let Some(cam) = scene.camera() else {

@@ -9,7 +9,8 @@ use common::rslf_with_env;
 fn the_ablation_prints_and_writes_the_four_row_table() {
     let root = common::tempdir();
     let config = root.path().join("small.toml");
-    std::fs::write(&config, "[stage1]\ngaussians = 300\niterations = 5\nband_height = 16\n[stage2]\niterations = 3\nbands_per_step = 1\n").unwrap();
+    std::fs::write(&config, "[stage1]\ngaussians = 300\niterations = 5\nband_height = 16\n[stage2]\niterations = 3\nbands_per_step = 1\n")
+        .unwrap();
     let out = root.path().join("ablation");
     let (ok, stdout, stderr) = rslf_with_env(
         &["ablation", config.to_str().unwrap(), "--size", "32", "--bases", "objects", "--directions", "1", "--out", out.to_str().unwrap()],

@@ -19,14 +19,8 @@ fn valid_scene(root: &Path) -> (PathBuf, PathBuf) {
 /// Runs `rslf train` and checks the failure: message names `culprit`, no panic, no output folder.
 fn assert_train_fails(scene: &Path, config: &Path, culprit: &str, problem: &str) {
     let out = scene.parent().unwrap().join("out");
-    let (ok, _stdout, stderr) = rslf(&[
-        "train",
-        config.to_str().unwrap(),
-        "--scene",
-        scene.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, _stdout, stderr) =
+        rslf(&["train", config.to_str().unwrap(), "--scene", scene.to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert!(!ok, "expected failure for {culprit}");
     assert_eq!(stderr.matches("panicked").count(), 0, "{stderr}");
     assert_eq!(stderr.trim().lines().count(), 1, "one line expected: {stderr}");

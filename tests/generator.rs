@@ -46,7 +46,8 @@ fn moving_ground_truth_points_land_on_every_rolling_shutter_view_under_the_true_
     let gt = GroundTruth::load(&scene.dir, S, S).unwrap();
     assert_eq!(gt.motion.as_ref(), Some(&motion));
     let (depth, central0, mask) = (gt.depth.unwrap(), gt.central.unwrap(), gt.mask.unwrap());
-    let scaled = |k: f64| MotionRecord::ConstantVelocity { omega_rad_s: [0.1 * k, 0.25 * k, -0.2 * k], velocity_m_s: [0.6 * k, -0.3 * k, 0.5 * k] };
+    let scaled =
+        |k: f64| MotionRecord::ConstantVelocity { omega_rad_s: [0.1 * k, 0.25 * k, -0.2 * k], velocity_m_s: [0.6 * k, -0.3 * k, 0.5 * k] };
     // Mean colour error between the t = 0 central view and `view` sampled where `motion` puts
     // each visible ground-truth point, over the samples; and the largest shift from the static
     // projection.
@@ -76,14 +77,19 @@ fn moving_ground_truth_points_land_on_every_rolling_shutter_view_under_the_true_
     for view in views {
         let (truth, n, shift) = error(view, &motion);
         let (still, smaller, larger) = (error(view, &scaled(0.0)).0, error(view, &scaled(0.9)).0, error(view, &scaled(1.1)).0);
-        eprintln!("view {view:?}: colour error {truth:.4} under the true motion (x0.9 {smaller:.4}, x1.1 {larger:.4}, none {still:.4}) over {n} samples, largest shift {shift:.2} px");
+        eprintln!(
+            "view {view:?}: colour error {truth:.4} under the true motion (x0.9 {smaller:.4}, x1.1 {larger:.4}, none {still:.4}) over {n} samples, largest shift {shift:.2} px"
+        );
         assert!(n > 3 * (S - 8) * (S - 8) * 8 / 10, "view {view:?}: most pixels are masked visible and land inside: {n}");
         assert!(shift > 4.0, "view {view:?}: the motion must move points visibly: {shift} px");
         // What remains is resampling and, in the corners, what they see behind foreground edges.
         assert!(truth < 0.03, "view {view:?}: colour error {truth} following the true motion");
         assert!(still > 2.0 * truth, "view {view:?}: ignoring the motion must be worse: {still} vs {truth}");
         // The data's own minimum is at the true motion: a 10 % error either way is worse.
-        assert!(smaller > 1.05 * truth && larger > 1.05 * truth, "view {view:?}: {truth} at the truth, {smaller} at 0.9x, {larger} at 1.1x");
+        assert!(
+            smaller > 1.05 * truth && larger > 1.05 * truth,
+            "view {view:?}: {truth} at the truth, {smaller} at 0.9x, {larger} at 1.1x"
+        );
     }
     assert!(mask.iter().any(|&m| !m), "some points leave the view or get hidden under motion");
 }
@@ -144,10 +150,8 @@ fn the_readme_suite_table_is_what_the_generator_lists() {
         })
         .collect();
     assert_eq!(listed.len(), 33, "{stdout}");
-    let table: Vec<&str> = readme
-        .lines()
-        .filter(|l| l.starts_with("| `") && ["| static |", "| slow |", "| fast |"].iter().any(|k| l.contains(k)))
-        .collect();
+    let table: Vec<&str> =
+        readme.lines().filter(|l| l.starts_with("| `") && ["| static |", "| slow |", "| fast |"].iter().any(|k| l.contains(k))).collect();
     assert_eq!(table, listed.iter().map(String::as_str).collect::<Vec<_>>());
 }
 

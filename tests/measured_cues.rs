@@ -34,7 +34,9 @@ fn antinous_corners_sit_where_the_central_row_disparity_puts_them() {
     assert!(mx < 0.15 && my < 0.15, "median |offset| {mx} / {my}");
     assert!(sx.abs() < 0.01 && sy.abs() < 0.01, "median offset {sx} / {sy}");
     // Each cue's disparity is the truth's where the patch lies (HCI's disparity sign).
-    let err = median(cues.iter().map(|c| (c.disparity - guess.data[c.at.1 as usize * guess.width + c.at.0.round() as usize] as f64).abs()).collect());
+    let err = median(
+        cues.iter().map(|c| (c.disparity - guess.data[c.at.1 as usize * guess.width + c.at.0.round() as usize] as f64).abs()).collect(),
+    );
     assert!(err < 0.05, "median disparity error {err}");
 }
 
@@ -57,8 +59,10 @@ fn a_pan_shows_in_the_measured_cues_as_its_motion_predicts_them() {
     let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
     let cues = measure_cues(&scene, gt.disparity.as_ref().unwrap());
     assert!(cues.len() > 2000, "{} cues", cues.len());
-    let pairs: Vec<((f64, f64), (f64, f64))> = cues.iter().filter_map(|c| predicted_cue(&camera, &truth, c).map(|p| (c.offset, p))).collect();
-    let miss = |f: &dyn Fn(&(f64, f64)) -> (f64, f64)| median(pairs.iter().map(|(m, p)| (m.0 - f(p).0).hypot(m.1 - f(p).1)).collect());
+    // A cue offset (px), and (measured, predicted) per cue.
+    type Offset = (f64, f64);
+    let pairs: Vec<(Offset, Offset)> = cues.iter().filter_map(|c| predicted_cue(&camera, &truth, c).map(|p| (c.offset, p))).collect();
+    let miss = |f: &dyn Fn(&Offset) -> Offset| median(pairs.iter().map(|(m, p)| (m.0 - f(p).0).hypot(m.1 - f(p).1)).collect());
     let (with_truth, with_none) = (miss(&|p| *p), miss(&|_| (0.0, 0.0)));
     eprintln!("{} cues; median miss {with_truth:.4} px with the true motion, {with_none:.4} px with none", pairs.len());
     assert!(with_truth < 0.75 * with_none, "{with_truth} against {with_none}");
@@ -106,7 +110,8 @@ fn the_cue_term_is_zero_at_the_motion_its_cues_were_predicted_from() {
     let value = |record: &MotionRecord| {
         let params: Vec<f32> = model.parameters_of(record).unwrap().iter().map(|&x| x as f32).collect();
         let n = params.len();
-        let t: Tensor<1> = term.evaluate(TensorCamera::new(&camera), model.as_ref(), Tensor::from_data(TensorData::new(params, [n]), &device));
+        let t: Tensor<1> =
+            term.evaluate(TensorCamera::new(&camera), model.as_ref(), Tensor::from_data(TensorData::new(params, [n]), &device));
         t.into_scalar::<f32>() as f64
     };
     let (at_truth, at_zero) = (value(&truth), value(&MotionRecord::zero()));

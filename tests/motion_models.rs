@@ -68,7 +68,12 @@ fn tensor_poses_follow_the_host_laws_of_every_model() {
             for a in 0..3 {
                 for b in 0..3 {
                     let got = r[i * 9 + a * 3 + b] as f64;
-                    assert!((got - expected.rotation[(a, b)]).abs() < 2e-6, "{} t={time} R[{a}{b}] {got} vs {}", m.name(), expected.rotation[(a, b)]);
+                    assert!(
+                        (got - expected.rotation[(a, b)]).abs() < 2e-6,
+                        "{} t={time} R[{a}{b}] {got} vs {}",
+                        m.name(),
+                        expected.rotation[(a, b)]
+                    );
                 }
                 let got = tr[i * 3 + a] as f64;
                 assert!((got - expected.translation[a]).abs() < 2e-6, "{} t={time} T[{a}] {got} vs {}", m.name(), expected.translation[a]);
@@ -109,7 +114,8 @@ fn gaussians() -> GaussianSet {
 fn objective(m: &dyn MotionModel, params: &[f64], timing: RsTiming, device: &Device) -> (Tensor<1>, Tensor<1>) {
     let cam = camera();
     let g = gaussians().to_module(device);
-    let p = Tensor::<1>::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), device).require_grad();
+    let p = Tensor::<1>::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), device)
+        .require_grad();
     let shape = StaticShape::new(&g, TensorCamera::new(&cam), m, p.clone());
     // Every Gaussian in every bin and a footprint out to 6σ: the bins, recomputed in each
     // evaluation, then cannot change the value (a 3σ cut-off would add jumps of e^-4.5).

@@ -40,7 +40,15 @@ fn the_central_column_finds_the_disparity_of_horizontal_stripes_the_row_cannot_s
     // whatever the disparity, the views of the central column show them shifted by (r-rc) d.
     let dir = common::tempdir();
     let d = 0.8;
-    common::write_plane_scene_with(dir.path(), 64, 64, 5, d, |_| true, |_, y, ch| (0.5 + 0.3 * (0.7 * y + ch as f64).sin() + 0.1 * (0.23 * y).cos()) as f32);
+    common::write_plane_scene_with(
+        dir.path(),
+        64,
+        64,
+        5,
+        d,
+        |_| true,
+        |_, y, ch| (0.5 + 0.3 * (0.7 * y + ch as f64).sin() + 0.1 * (0.23 * y).cos()) as f32,
+    );
     let scene = Scene::load(dir.path()).unwrap();
     let truth = Raster::from_vec(64, 64, 1, vec![d as f32; 64 * 64]).unwrap();
     let settings = PlaneSweepSettings { range: (-2.0, 2.0), step: 0.05, window_radius: 2 };

@@ -30,8 +30,16 @@ fn train(dir: &Path, scene: &str, name: &str, motion_steps: usize) -> String {
     .unwrap();
     let out = dir.join("results").join(name);
     let models = dir.join("models");
-    let (ok, _, stderr) =
-        rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap(), "--models", models.to_str().unwrap(), "--device", "flex"]);
+    let (ok, _, stderr) = rslf(&[
+        "train",
+        config.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--models",
+        models.to_str().unwrap(),
+        "--device",
+        "flex",
+    ]);
     assert!(ok, "{stderr}");
     models.join(name).to_str().unwrap().to_string()
 }
@@ -40,7 +48,8 @@ fn train(dir: &Path, scene: &str, name: &str, motion_steps: usize) -> String {
 /// `index % 9`).
 fn view_psnr(stdout: &str, index: usize) -> f64 {
     let row = format!("r{}", index / 9);
-    let line = stdout.lines().find(|l| l.split_whitespace().next() == Some(row.as_str())).unwrap_or_else(|| panic!("no grid row {row}: {stdout}"));
+    let line =
+        stdout.lines().find(|l| l.split_whitespace().next() == Some(row.as_str())).unwrap_or_else(|| panic!("no grid row {row}: {stdout}"));
     let cells: Vec<&str> = line.split_whitespace().skip(1).collect();
     assert_eq!(cells.len(), 9, "{line}");
     cells[index % 9].parse().unwrap_or_else(|_| panic!("view {index}: {line}"))
@@ -98,7 +107,8 @@ fn with_motion_t0_is_global_shutter_and_capture_keeps_the_shutter() {
 #[test]
 fn a_missing_model_is_a_one_line_error() {
     let root = common::tempdir();
-    let (ok, _, stderr) = rslf(&["render", root.path().join("nothing").to_str().unwrap(), "--out", root.path().join("x").to_str().unwrap()]);
+    let (ok, _, stderr) =
+        rslf(&["render", root.path().join("nothing").to_str().unwrap(), "--out", root.path().join("x").to_str().unwrap()]);
     assert!(!ok);
     assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
     assert!(!root.path().join("x").exists());

@@ -11,13 +11,9 @@ fn png_bit_depths_and_channels_are_scaled_to_unit_range() {
     let dir = common::tempdir();
     let p = |n: &str| dir.path().join(n);
     image::GrayImage::from_fn(3, 2, |x, _| image::Luma([(x * 127) as u8])).save(p("g8.png")).unwrap();
-    image::ImageBuffer::<image::Luma<u16>, _>::from_fn(3, 2, |x, _| image::Luma([(x * 32767) as u16]))
-        .save(p("g16.png"))
-        .unwrap();
+    image::ImageBuffer::<image::Luma<u16>, _>::from_fn(3, 2, |x, _| image::Luma([(x * 32767) as u16])).save(p("g16.png")).unwrap();
     image::RgbaImage::from_fn(3, 2, |_, y| image::Rgba([255, 0, (y * 255) as u8, 7])).save(p("rgba8.png")).unwrap();
-    image::ImageBuffer::<image::Rgb<u16>, _>::from_fn(3, 2, |_, _| image::Rgb([65535u16, 0, 32768]))
-        .save(p("rgb16.png"))
-        .unwrap();
+    image::ImageBuffer::<image::Rgb<u16>, _>::from_fn(3, 2, |_, _| image::Rgb([65535u16, 0, 32768])).save(p("rgb16.png")).unwrap();
 
     let g8 = read_image(&p("g8.png")).unwrap();
     assert_eq!((g8.width, g8.height, g8.channels), (3, 2, 1));

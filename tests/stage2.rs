@@ -14,7 +14,11 @@ fn generate(dir: &Path) {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml")).unwrap();
     let text = text.replace("size = [512, 512]", "size = [64, 64]").replace("supersampling = 2", "supersampling = 1");
     let description = dir.join("moving.toml");
-    std::fs::write(&description, format!("{text}\n[motion]\nmodel = \"constant_velocity\"\nomega_rad_s = [0.0, 1.0, 0.0]\nvelocity_m_s = [0.0, 0.0, 0.0]\n")).unwrap();
+    std::fs::write(
+        &description,
+        format!("{text}\n[motion]\nmodel = \"constant_velocity\"\nomega_rad_s = [0.0, 1.0, 0.0]\nvelocity_m_s = [0.0, 0.0, 0.0]\n"),
+    )
+    .unwrap();
     let (ok, _, stderr) = rslf(&["generate", description.to_str().unwrap(), "--out", dir.join("scene").to_str().unwrap()]);
     assert!(ok, "{stderr}");
 }
@@ -57,7 +61,15 @@ fn each_motion_model_runs_by_config_and_writes_format_results() {
         let stdout = train(root.path(), &config(root.path(), model, model, extra), model);
         assert!(stdout.contains(&format!("stage 2 fit: `{model}` motion")), "{stdout}");
         if masked {
-            let share: f64 = stdout.split("% of the pixels compared (disocclusions masked)").next().unwrap().rsplit(' ').next().unwrap().parse().unwrap();
+            let share: f64 = stdout
+                .split("% of the pixels compared (disocclusions masked)")
+                .next()
+                .unwrap()
+                .rsplit(' ')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap();
             assert!((80.0..100.0).contains(&share), "{share}% compared: {stdout}");
         } else {
             assert!(stdout.contains("every pixel compared"), "{stdout}");
@@ -90,7 +102,12 @@ fn compensating_with_the_true_motion_restores_the_t0_view() {
     generate(root.path());
     let scene = root.path().join("scene");
     let truth = scene.join("gt_motion.toml");
-    let with_truth = config(root.path(), "truth", "constant_velocity", &format!("iterations = 0\nrefine_gaussians = 0.0\ninitial_motion = {:?}", truth.to_str().unwrap()));
+    let with_truth = config(
+        root.path(),
+        "truth",
+        "constant_velocity",
+        &format!("iterations = 0\nrefine_gaussians = 0.0\ninitial_motion = {:?}", truth.to_str().unwrap()),
+    );
     let without = config(root.path(), "none", "constant_velocity", "iterations = 0\nrefine_gaussians = 0.0");
     train(root.path(), &with_truth, "truth");
     let stdout = train(root.path(), &without, "none");

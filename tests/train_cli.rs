@@ -20,7 +20,8 @@ fn train_recovers_the_disparity_of_a_plane_and_writes_a_format_result() {
     let out = root.path().join("result");
 
     let models = root.path().join("models");
-    let (ok, stdout, stderr) = rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap(), "--models", models.to_str().unwrap()]);
+    let (ok, stdout, stderr) =
+        rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap(), "--models", models.to_str().unwrap()]);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("stage 1 initialisation"), "{stdout}");
     // A global-shutter capture: the central column is fitted too, as many views as the row's.

@@ -137,9 +137,9 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
             optional(r.motion_error_px),
             optional(r.true_shift_px),
             r.seconds
-            )
-        }))
-        .collect();
+        )
+    }))
+    .collect();
     write_atomic(&args.out.join("ablation.csv"), csv.as_bytes())?;
     write_atomic(&args.out.join("ablation.md"), table.as_bytes())?;
     println!("wrote {} and ablation.csv", args.out.join("ablation.md").display());
@@ -151,7 +151,8 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
 /// share of the true rolling-shutter shift).
 fn table(rows: &[Row]) -> String {
     let mean_to = |digits: usize, variant: &str, category: &str, value: &dyn Fn(&Row) -> f64| {
-        let v: Vec<f64> = rows.iter().filter(|r| r.variant == variant && r.category == category).map(value).filter(|x| x.is_finite()).collect();
+        let v: Vec<f64> =
+            rows.iter().filter(|r| r.variant == variant && r.category == category).map(value).filter(|x| x.is_finite()).collect();
         if v.is_empty() { "n/a".to_string() } else { format!("{:.digits$}", v.iter().sum::<f64>() / v.len() as f64) }
     };
     let mean = |variant: &str, category: &str, value: &dyn Fn(&Row) -> f64| mean_to(4, variant, category, value);

@@ -102,7 +102,11 @@ pub fn run(args: RenderArgs) -> crate::Result<()> {
     print!("{}", psnr_grid(&scene, &scores));
     let mean = scores.iter().map(|(_, db)| db).sum::<f64>() / scores.len() as f64;
     let (worst_view, worst) = scores.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).expect("a scene has its central view");
-    println!("PSNR against the {} input views of {}: mean {mean:.2} dB, lowest {worst:.2} dB (view {worst_view})", scores.len(), scene_dir.display());
+    println!(
+        "PSNR against the {} input views of {}: mean {mean:.2} dB, lowest {worst:.2} dB (view {worst_view})",
+        scores.len(),
+        scene_dir.display()
+    );
     Ok(())
 }
 

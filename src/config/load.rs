@@ -36,9 +36,8 @@ impl std::error::Error for ConfigError {}
 fn table_at(text: &str, offset: usize) -> Option<String> {
     text[..offset.min(text.len())].lines().rev().find_map(|l| {
         let l = l.trim();
-        let name = l.strip_prefix("[[").and_then(|r| r.split("]]").next()).or_else(|| {
-            l.strip_prefix('[').and_then(|r| r.split(']').next())
-        })?;
+        let name =
+            l.strip_prefix("[[").and_then(|r| r.split("]]").next()).or_else(|| l.strip_prefix('[').and_then(|r| r.split(']').next()))?;
         Some(name.trim().to_string())
     })
 }
@@ -70,12 +69,7 @@ impl Config {
             let key = if message.starts_with("unknown field") { None } else { key };
             ConfigError { path: path.to_path_buf(), line, key, message }
         })?;
-        config.validate().map_err(|(key, message)| ConfigError {
-            path: path.to_path_buf(),
-            line: None,
-            key: Some(key),
-            message,
-        })?;
+        config.validate().map_err(|(key, message)| ConfigError { path: path.to_path_buf(), line: None, key: Some(key), message })?;
         Ok(config)
     }
 

@@ -15,7 +15,6 @@ pub enum DeviceChoice {
     Wgpu,
 }
 
-
 /// A whole run: `rslf train CONFIG`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -291,11 +290,7 @@ fn one() -> f64 {
 /// at 24.6 %, weight 0.5 at 26.6 %), and in stage 2 a motion prior of weight 3e-5 (it holds
 /// a static scene still: at 256 px, 1.88 px of drift without it, 0.47 px with it).
 fn default_losses() -> Vec<LossConfig> {
-    vec![
-        LossConfig::new("l1", 1.0),
-        LossConfig::new("smoothness", 0.05),
-        LossConfig::new("motion_prior", 3e-5),
-    ]
+    vec![LossConfig::new("l1", 1.0), LossConfig::new("smoothness", 0.05), LossConfig::new("motion_prior", 3e-5)]
 }
 
 impl Default for Config {

@@ -42,9 +42,9 @@ pub struct DisparityMetrics {
 pub fn disparity_metrics(est: &Raster, gt: &Raster, region: &[bool]) -> DisparityMetrics {
     let (mut sq, mut finite, mut pixels, mut non_finite) = (0.0f64, 0usize, 0usize, 0usize);
     let mut bad = [0usize; BADPIX_THRESHOLDS.len()];
-    for i in 0..gt.pixels() {
-        let (e, g) = (est.data[i] as f64, gt.data[i] as f64);
-        if !region[i] || !g.is_finite() {
+    for ((&e, &g), &inside) in est.data.iter().zip(&gt.data).zip(region) {
+        let (e, g) = (e as f64, g as f64);
+        if !inside || !g.is_finite() {
             continue;
         }
         pixels += 1;
@@ -87,9 +87,9 @@ pub struct DepthMetrics {
 /// Depth metrics of `est` against `gt` over `region`.
 pub fn depth_metrics(est: &Raster, gt: &Raster, region: &[bool]) -> DepthMetrics {
     let (mut abs, mut sq, mut good, mut pixels, mut non_finite) = (0.0f64, 0.0f64, 0usize, 0usize, 0usize);
-    for i in 0..gt.pixels() {
-        let (z, g) = (est.data[i] as f64, gt.data[i] as f64);
-        if !region[i] || !g.is_finite() || g <= 0.0 {
+    for ((&z, &g), &inside) in est.data.iter().zip(&gt.data).zip(region) {
+        let (z, g) = (z as f64, g as f64);
+        if !inside || !g.is_finite() || g <= 0.0 {
             continue;
         }
         if !z.is_finite() {

@@ -6,8 +6,8 @@ mod observability;
 mod report;
 
 pub use metrics::{
-    BADPIX_THRESHOLDS, DepthMetrics, DisparityMetrics, HCI_BORDER_PX, ParameterError, depth_metrics, disparity_metrics,
-    evaluation_region, motion_parameter_errors, psnr_db,
+    BADPIX_THRESHOLDS, DepthMetrics, DisparityMetrics, HCI_BORDER_PX, ParameterError, depth_metrics, disparity_metrics, evaluation_region,
+    motion_parameter_errors, psnr_db,
 };
 pub use motion_error::{ImageMotionError, image_motion_error};
 pub use observability::{Observability, PARAMETER_NAMES, observability};
@@ -57,7 +57,10 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
         return Err(IoError::new(result, "has none of disparity.pfm, depth.pfm, central.png, motion.toml"));
     }
     if gt.is_empty() {
-        return Err(IoError::new(scene_dir, "has no ground truth (gt_disp_lowres.pfm, gt_depth_lowres.pfm, gt_central.png, gt_motion.toml)"));
+        return Err(IoError::new(
+            scene_dir,
+            "has no ground truth (gt_disp_lowres.pfm, gt_depth_lowres.pfm, gt_central.png, gt_motion.toml)",
+        ));
     }
 
     let mut notes = Vec::new();

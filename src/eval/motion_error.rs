@@ -24,7 +24,13 @@ pub struct ImageMotionError {
 /// each way, finite positive depth), in the central view and the four corners; each point is
 /// imaged at the read-out time of the row it lands on. Points that either motion cannot image
 /// (behind the camera, no settled row) are left out. `None` when no point is left.
-pub fn image_motion_error(camera: &Camera, estimate: &MotionRecord, truth: &MotionRecord, gt_depth: &Raster, stride: usize) -> Option<ImageMotionError> {
+pub fn image_motion_error(
+    camera: &Camera,
+    estimate: &MotionRecord,
+    truth: &MotionRecord,
+    gt_depth: &Raster,
+    stride: usize,
+) -> Option<ImageMotionError> {
     let stride = stride.max(1);
     let zero = MotionRecord::zero();
     let mut views = vec![camera.grid.central()?];
@@ -67,7 +73,15 @@ mod tests {
     use crate::geometry::ViewGrid;
 
     fn setup() -> (Camera, Raster) {
-        let cam = Camera { grid: ViewGrid { rows: 9, cols: 9 }, width: 64, height: 48, f_px: 80.0, baseline_m: 0.02, focus_m: 3.0, line_time_s: 4e-4 };
+        let cam = Camera {
+            grid: ViewGrid { rows: 9, cols: 9 },
+            width: 64,
+            height: 48,
+            f_px: 80.0,
+            baseline_m: 0.02,
+            focus_m: 3.0,
+            line_time_s: 4e-4,
+        };
         let depth = Raster { width: 64, height: 48, channels: 1, data: (0..64 * 48).map(|i| 2.0 + (i % 7) as f32 * 0.3).collect() };
         (cam, depth)
     }

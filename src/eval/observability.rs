@@ -118,9 +118,7 @@ pub fn observability(camera: &Camera, truth: &MotionRecord, gt_depth: &Raster, s
     if points == 0 {
         return None;
     }
-    let per_parameter = (0..6)
-        .map(|j| (PARAMETER_NAMES[j].to_string(), (cue[(j, j)] / effect[(j, j)]).sqrt()))
-        .collect();
+    let per_parameter = (0..6).map(|j| (PARAMETER_NAMES[j].to_string(), (cue[(j, j)] / effect[(j, j)]).sqrt())).collect();
     // Parameters in image-space units (one unit: 1 px RMS effect), then the generalised
     // eigenproblem cue x = λ effect x through a Cholesky factor of the effect.
     let unit = SVector::<f64, 6>::from_fn(|j, _| effect[(j, j)].sqrt().recip());
@@ -176,7 +174,15 @@ mod tests {
     use crate::geometry::ViewGrid;
 
     fn camera() -> Camera {
-        Camera { grid: ViewGrid { rows: 9, cols: 9 }, width: 64, height: 64, f_px: 180.0, baseline_m: 0.025, focus_m: 4.5, line_time_s: 4e-4 }
+        Camera {
+            grid: ViewGrid { rows: 9, cols: 9 },
+            width: 64,
+            height: 64,
+            f_px: 180.0,
+            baseline_m: 0.025,
+            focus_m: 4.5,
+            line_time_s: 4e-4,
+        }
     }
 
     /// Depth `z(u, v)` at every pixel.

@@ -79,7 +79,15 @@ mod tests {
 
     #[test]
     fn agrees_with_the_host_camera() {
-        let cam = Camera { grid: ViewGrid { rows: 9, cols: 9 }, width: 512, height: 384, f_px: 1463.0, baseline_m: 0.025, focus_m: 4.5, line_time_s: 6.5e-5 };
+        let cam = Camera {
+            grid: ViewGrid { rows: 9, cols: 9 },
+            width: 512,
+            height: 384,
+            f_px: 1463.0,
+            baseline_m: 0.025,
+            focus_m: 4.5,
+            line_time_s: 6.5e-5,
+        };
         let tc = TensorCamera::new(&cam);
         let device = Device::flex();
         let t = |v: Vec<f32>| Tensor::<1>::from_data(TensorData::new(v.clone(), [v.len()]), &device);

@@ -3,12 +3,12 @@
 
 mod camera;
 mod lift;
-mod rotation;
 mod rigid_motion;
+mod rotation;
 mod rs_projection;
 
 pub use camera::{Camera, ViewGrid, ViewId};
-pub use rigid_motion::{Pose, pose_at, readout_interval};
-pub use rs_projection::rs_project;
 pub use lift::TensorCamera;
+pub use rigid_motion::{Pose, pose_at, readout_interval};
 pub use rotation::{PoseBatch, compose, rotate, rotate_inverse, rotation_matrices};
+pub use rs_projection::rs_project;

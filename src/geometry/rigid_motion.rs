@@ -34,12 +34,8 @@ impl Pose {
 
     /// Constant velocity over a time `dt`: `R(dt ω)`, `dt v`.
     fn constant_velocity(omega: &[f64; 3], velocity: &[f64; 3], dt: f64) -> Self {
-        Self {
-            rotation: Rotation3::new(Vector3::from(*omega) * dt),
-            translation: Vector3::from(*velocity) * dt,
-        }
+        Self { rotation: Rotation3::new(Vector3::from(*omega) * dt), translation: Vector3::from(*velocity) * dt }
     }
-
 }
 
 /// The read-out interval of an image of `height` rows: `[t(0), t(H-1)]`, centred on t = 0.
@@ -162,10 +158,7 @@ mod tests {
 
     #[test]
     fn even_segment_counts_split_at_zero() {
-        let pw = MotionRecord::PiecewiseConstant {
-            omega_rad_s: vec![[0.0; 3]; 2],
-            velocity_m_s: vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-        };
+        let pw = MotionRecord::PiecewiseConstant { omega_rad_s: vec![[0.0; 3]; 2], velocity_m_s: vec![[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] };
         let r = (-1.0, 1.0);
         assert!((pose_at(&pw, 0.5, r).translation - Vector3::new(0.0, 0.5, 0.0)).norm() < 1e-12);
         assert!((pose_at(&pw, -0.5, r).translation - Vector3::new(-0.5, 0.0, 0.0)).norm() < 1e-12);

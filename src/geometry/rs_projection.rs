@@ -35,7 +35,15 @@ mod tests {
     use crate::geometry::ViewGrid;
 
     fn camera() -> Camera {
-        Camera { grid: ViewGrid { rows: 9, cols: 9 }, width: 512, height: 512, f_px: 1463.0, baseline_m: 0.025, focus_m: 4.5, line_time_s: 6.5e-5 }
+        Camera {
+            grid: ViewGrid { rows: 9, cols: 9 },
+            width: 512,
+            height: 512,
+            f_px: 1463.0,
+            baseline_m: 0.025,
+            focus_m: 4.5,
+            line_time_s: 6.5e-5,
+        }
     }
 
     #[test]

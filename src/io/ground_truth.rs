@@ -54,9 +54,8 @@ impl GroundTruth {
             }
             Ok(r)
         };
-        let mask = image("gt_mask.png")?.map(|m| {
-            m.data.chunks_exact(m.channels).map(|px| px.iter().any(|&v| v > 0.0)).collect::<Vec<bool>>()
-        });
+        let mask =
+            image("gt_mask.png")?.map(|m| m.data.chunks_exact(m.channels).map(|px| px.iter().any(|&v| v > 0.0)).collect::<Vec<bool>>());
         Ok(Self {
             disparity: map("gt_disp_lowres.pfm")?,
             depth: map("gt_depth_lowres.pfm")?,

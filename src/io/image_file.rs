@@ -22,8 +22,7 @@ pub fn read_image(path: &Path) -> IoResult<Raster> {
 
 fn decode_png(bytes: &[u8]) -> Result<Raster, String> {
     use image::DynamicImage as D;
-    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
-        .map_err(|e| format!("unreadable PNG: {e}"))?;
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png).map_err(|e| format!("unreadable PNG: {e}"))?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     let (channels, data): (usize, Vec<f32>) = match img {
         D::ImageLuma8(b) => (1, b.into_raw().into_iter().map(|v| v as f32 / 255.0).collect()),
@@ -103,7 +102,6 @@ pub fn write_png(path: &Path, img: &Raster) -> IoResult<()> {
 /// Writes a mask (non-zero = set) as an 8-bit grey PNG of 0 and 255.
 pub fn write_mask_png(path: &Path, mask: &[bool], width: usize, height: usize) -> IoResult<()> {
     let data = mask.iter().map(|&m| if m { 1.0 } else { 0.0 }).collect();
-    let raster = Raster::from_vec(width, height, 1, data)
-        .ok_or_else(|| IoError::new(path, "mask length does not match its size"))?;
+    let raster = Raster::from_vec(width, height, 1, data).ok_or_else(|| IoError::new(path, "mask length does not match its size"))?;
     write_png(path, &raster)
 }

@@ -98,9 +98,8 @@ impl MotionRecord {
             }
             "constant_acceleration" => {
                 extra("segments", raw.segments.is_some())?;
-                let need = |key: &str, v: &Option<toml::Value>| {
-                    v.as_ref().ok_or_else(|| format!("`{key}` is missing")).and_then(|v| vec3(key, v))
-                };
+                let need =
+                    |key: &str, v: &Option<toml::Value>| v.as_ref().ok_or_else(|| format!("`{key}` is missing")).and_then(|v| vec3(key, v));
                 Ok(Self::ConstantAcceleration {
                     omega_rad_s: vec3("omega_rad_s", &raw.omega_rad_s)?,
                     velocity_m_s: vec3("velocity_m_s", &raw.velocity_m_s)?,
@@ -123,9 +122,7 @@ impl MotionRecord {
                 }
                 Ok(Self::PiecewiseConstant { omega_rad_s: omega, velocity_m_s: velocity })
             }
-            other => Err(format!(
-                "unknown model `{other}` (expected constant_velocity, constant_acceleration or piecewise_constant)"
-            )),
+            other => Err(format!("unknown model `{other}` (expected constant_velocity, constant_acceleration or piecewise_constant)")),
         }
     }
 

@@ -43,16 +43,12 @@ fn parse_ini(text: &str) -> Result<Ini, String> {
             continue;
         }
         if let Some(rest) = line.strip_prefix('[') {
-            let name = rest
-                .strip_suffix(']')
-                .ok_or_else(|| format!("line {line_no}: section header `{line}` has no closing `]`"))?;
+            let name = rest.strip_suffix(']').ok_or_else(|| format!("line {line_no}: section header `{line}` has no closing `]`"))?;
             section = name.trim().to_string();
             ini.entry(section.clone()).or_default();
             continue;
         }
-        let (key, value) = line
-            .split_once('=')
-            .ok_or_else(|| format!("line {line_no}: expected `key = value`, found `{line}`"))?;
+        let (key, value) = line.split_once('=').ok_or_else(|| format!("line {line_no}: expected `key = value`, found `{line}`"))?;
         let key = key.trim().to_string();
         let entries = ini.entry(section.clone()).or_default();
         if entries.contains_key(&key) {

@@ -64,11 +64,7 @@ impl Raster {
         if self.channels == 1 {
             return self.clone();
         }
-        let data = self
-            .data
-            .chunks_exact(self.channels)
-            .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
-            .collect();
+        let data = self.data.chunks_exact(self.channels).map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]).collect();
         Raster { width: self.width, height: self.height, channels: 1, data }
     }
 }

@@ -48,10 +48,10 @@ impl Scene {
         for entry in entries {
             let entry = entry.map_err(|e| IoError::os(dir, e))?;
             let name = entry.file_name().to_string_lossy().into_owned();
-            if let Some(index) = parse_view_name(&name) {
-                if let Some(other) = files.insert(index, entry.path()) {
-                    return Err(IoError::new(&other, format!("view {index} is given twice (also as {name})")));
-                }
+            if let Some(index) = parse_view_name(&name)
+                && let Some(other) = files.insert(index, entry.path())
+            {
+                return Err(IoError::new(&other, format!("view {index} is given twice (also as {name})")));
             }
         }
         let Some(&max_index) = files.keys().next_back() else {
@@ -73,44 +73,32 @@ impl Scene {
                 format!("view index {max_index} is outside the {}x{} grid of parameters.cfg", grid.rows, grid.cols),
             ));
         }
-        let central = grid.central().ok_or_else(|| {
-            IoError::new(dir, format!("a {}x{} view grid has no central view (needs odd sizes)", grid.rows, grid.cols))
-        })?;
+        let central = grid
+            .central()
+            .ok_or_else(|| IoError::new(dir, format!("a {}x{} view grid has no central view (needs odd sizes)", grid.rows, grid.cols)))?;
         let central_index = grid.index(central);
         if !files.contains_key(&central_index) {
             return Err(IoError::new(dir, format!("no central view ({})", view_file_name(central_index))));
         }
 
-        let loaded: Vec<(usize, Raster)> = files
-            .par_iter()
-            .map(|(&i, path)| read_image(path).map(|r| (i, r)))
-            .collect::<IoResult<_>>()?;
+        let loaded: Vec<(usize, Raster)> = files.par_iter().map(|(&i, path)| read_image(path).map(|r| (i, r))).collect::<IoResult<_>>()?;
         let reference = &loaded.iter().find(|(i, _)| *i == central_index).expect("central view loaded").1;
         let (w, h, ch) = (reference.width, reference.height, reference.channels);
         for (i, r) in &loaded {
             if (r.width, r.height) != (w, h) {
-                return Err(IoError::new(
-                    &files[i],
-                    format!("view is {}x{} but the central view is {w}x{h}", r.width, r.height),
-                ));
+                return Err(IoError::new(&files[i], format!("view is {}x{} but the central view is {w}x{h}", r.width, r.height)));
             }
             if r.channels != ch {
-                return Err(IoError::new(
-                    &files[i],
-                    format!("view has {} channels but the central view has {ch}", r.channels),
-                ));
+                return Err(IoError::new(&files[i], format!("view has {} channels but the central view has {ch}", r.channels)));
             }
         }
-        if let Some(p) = &params {
-            if (p.image_resolution_x_px, p.image_resolution_y_px) != (w, h) {
-                return Err(IoError::new(
-                    &cfg_path,
-                    format!(
-                        "says {}x{} pixels but the views are {w}x{h}",
-                        p.image_resolution_x_px, p.image_resolution_y_px
-                    ),
-                ));
-            }
+        if let Some(p) = &params
+            && (p.image_resolution_x_px, p.image_resolution_y_px) != (w, h)
+        {
+            return Err(IoError::new(
+                &cfg_path,
+                format!("says {}x{} pixels but the views are {w}x{h}", p.image_resolution_x_px, p.image_resolution_y_px),
+            ));
         }
         let mut views = vec![None; grid.len()];
         for (i, r) in loaded {

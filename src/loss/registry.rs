@@ -79,11 +79,7 @@ pub struct WeightedLosses {
 impl WeightedLosses {
     /// The weighted sum for one band; `None` when no term applies.
     pub fn evaluate(&self, input: &LossInput) -> Option<Tensor<1>> {
-        self.terms
-            .iter()
-            .filter(|t| t.weight != 0.0)
-            .filter_map(|t| t.term.evaluate(input).map(|v| v * t.weight))
-            .reduce(|a, b| a + b)
+        self.terms.iter().filter(|t| t.weight != 0.0).filter_map(|t| t.term.evaluate(input).map(|v| v * t.weight)).reduce(|a, b| a + b)
     }
 
     /// `name×weight` of each term, for logs.

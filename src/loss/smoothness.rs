@@ -30,7 +30,8 @@ impl LossTerm for EdgeAwareSmoothness {
         let image = input.target.clone().reshape([h, w, c]);
         let horizontal = |t: Tensor<2>| t.clone().slice([0..h, 1..w]) - t.slice([0..h, 0..w - 1]);
         let vertical = |t: Tensor<2>| t.clone().slice([1..h, 0..w]) - t.slice([0..h - 1, 0..w]);
-        let edge_h = (image.clone().slice([0..h, 1..w, 0..c]) - image.clone().slice([0..h, 0..w - 1, 0..c])).abs().mean_dim(2).reshape([h, w - 1]);
+        let edge_h =
+            (image.clone().slice([0..h, 1..w, 0..c]) - image.clone().slice([0..h, 0..w - 1, 0..c])).abs().mean_dim(2).reshape([h, w - 1]);
         let edge_v = (image.clone().slice([1..h, 0..w, 0..c]) - image.slice([0..h - 1, 0..w, 0..c])).abs().mean_dim(2).reshape([h - 1, w]);
         let weight = |e: Tensor<2>| (e / -EDGE_SCALE).exp();
         let term_h = (horizontal(d.clone()).abs() * weight(edge_h)).mean();

@@ -13,7 +13,14 @@ fn output(colour: Tensor<2>, disparity: Vec<f32>, device: &Device) -> RenderOutp
     RenderOutput { colour, disparity: Tensor::from_data(TensorData::new(disparity, [n]), device), alpha: Tensor::ones([n], device) }
 }
 
-fn value(term: &dyn LossTerm, out: &RenderOutput, target: &Tensor<2>, rows: usize, width: usize, motion: Option<&Tensor<1>>) -> Option<f32> {
+fn value(
+    term: &dyn LossTerm,
+    out: &RenderOutput,
+    target: &Tensor<2>,
+    rows: usize,
+    width: usize,
+    motion: Option<&Tensor<1>>,
+) -> Option<f32> {
     term.evaluate(&LossInput { rendered: out, target, rows, width, motion }).map(|t| t.into_scalar::<f32>())
 }
 

@@ -40,7 +40,12 @@ pub struct StepReport {
 
 /// Runs `stage` on `model` under `objective`; returns the fitted model and the loss of each step
 /// (before its update). `progress` is called after each step.
-pub fn optimise<M: Module>(mut model: M, stage: &Stage, mut objective: impl Objective<M>, mut progress: impl FnMut(StepReport)) -> (M, Vec<f32>) {
+pub fn optimise<M: Module>(
+    mut model: M,
+    stage: &Stage,
+    mut objective: impl Objective<M>,
+    mut progress: impl FnMut(StepReport),
+) -> (M, Vec<f32>) {
     let mut optimiser = Optimiser::new(&stage.plan);
     let mut curve = Vec::with_capacity(stage.iterations);
     for step in 0..stage.iterations {

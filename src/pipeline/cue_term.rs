@@ -59,8 +59,7 @@ impl CueTerm {
                     colour: vec![0.0; n],
                     channels: 1,
                 };
-                let still: Vec<(f64, f64)> =
-                    mine.iter().map(|c| camera.grid.position_in_view(view, c.at.0, c.at.1, c.disparity)).collect();
+                let still: Vec<(f64, f64)> = mine.iter().map(|c| camera.grid.position_in_view(view, c.at.0, c.at.1, c.disparity)).collect();
                 let target = |k: usize| {
                     let data: Vec<f32> = mine
                         .iter()
@@ -70,7 +69,12 @@ impl CueTerm {
                     Tensor::<1>::from_data(TensorData::new(data, [n]), device)
                 };
                 let (a, b) = camera.grid.offset(view);
-                CornerCues { points: set.to_module(device).no_grad(), offset: (a as f32, b as f32), target_u: target(0), target_v: target(1) }
+                CornerCues {
+                    points: set.to_module(device).no_grad(),
+                    offset: (a as f32, b as f32),
+                    target_u: target(0),
+                    target_v: target(1),
+                }
             })
             .collect();
         Self { corners, weight, huber: HuberLossConfig::new(huber_px).init(), timing_iterations, len: cues.len() }

@@ -21,7 +21,7 @@ pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
 pub use measured_cues::{Cue, measure_cues, predicted_cue};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
-pub use results::{PointCloud, RunResult, depth_map};
+pub use results::{LossCurves, PointCloud, RunResult, depth_map};
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
 pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales};
 pub use view_tracking::{Track, TrackSettings, textured_points, track};
@@ -135,9 +135,7 @@ fn central_rasters(out: RenderOutput, w: usize, h: usize, c: usize, fallback: &R
     let colour = colour_raster(out.colour, w, h, c);
     let disparity = data(out.disparity.into_data());
     let alpha = data(out.alpha.into_data());
-    let disparity = (0..w * h)
-        .map(|i| if alpha[i] > TRUSTED_ALPHA { disparity[i] / alpha[i] } else { fallback.data[i] })
-        .collect();
+    let disparity = (0..w * h).map(|i| if alpha[i] > TRUSTED_ALPHA { disparity[i] / alpha[i] } else { fallback.data[i] }).collect();
     (colour, Raster { width: w, height: h, channels: 1, data: disparity })
 }
 
@@ -226,10 +224,20 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
                 None => vec![0.0; model.parameters().len()],
             };
             // The stage-1 geometry the disocclusion masks come from, rendered only when they are asked for.
-            let stage1_disparity =
-                config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
-            let fitted =
-                stage2(config, scene, cam, model.as_ref(), gaussians.clone(), &start, &stage2_losses, device, stage1_disparity.as_ref(), &initial, &mut log);
+            let stage1_disparity = config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
+            let fitted = stage2(
+                config,
+                scene,
+                cam,
+                model.as_ref(),
+                gaussians.clone(),
+                &start,
+                &stage2_losses,
+                device,
+                stage1_disparity.as_ref(),
+                &initial,
+                &mut log,
+            );
             let gaussians = fitted.gaussians.clone();
             let (central, disparity, shape) =
                 render_compensated_central(&gaussians, scene, cam, model.as_ref(), &fitted.parameters, &render, &initial, device);
@@ -269,7 +277,7 @@ fn stage1(
     losses: &WeightedLosses,
     device: &Device,
     log: &mut RunLog,
-) -> crate::Result<(Gaussians, Raster, Vec<(String, Vec<f32>)>)> {
+) -> crate::Result<(Gaussians, Raster, LossCurves)> {
     let initial = match &config.stage1.initial_disparity {
         Some(path) => {
             let map = crate::io::read_pfm(path)?;
@@ -358,7 +366,8 @@ fn stage2(
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
         views.extend(stage1_views(scene, s1.views, column_views(config, scene)));
-        let lr = LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
+        let lr =
+            LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
         (lr, s1.adam_epsilon as f32)
     });
     let fit = Stage2Fit {
@@ -377,10 +386,23 @@ fn stage2(
     };
     let bar = crate::progress::bar(s.iterations as u64, "stage 2: motion");
     let start = Instant::now();
-    let fitted = fit_stage2(gaussians, scene, camera, &views, model, start_values, &fit, losses, device, stage1_disparity, cue_term.as_ref(), |done, _, loss| {
-        bar.set_position(done as u64);
-        bar.set_message(format!("stage 2: loss {loss:.4}"));
-    });
+    let fitted = fit_stage2(
+        gaussians,
+        scene,
+        camera,
+        &views,
+        model,
+        start_values,
+        &fit,
+        losses,
+        device,
+        stage1_disparity,
+        cue_term.as_ref(),
+        |done, _, loss| {
+            bar.set_position(done as u64);
+            bar.set_message(format!("stage 2: loss {loss:.4}"));
+        },
+    );
     bar.finish_and_clear();
     log.lines.push(format!(
         "stage 2 fit: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4}, {:.1} s",

@@ -14,8 +14,8 @@
 //! regions wider than the window) the minimum means nothing: those pixels take the disparity of
 //! the nearest confident pixels left, right, above and below, weighted by inverse distance.
 
-use crate::geometry::ViewId;
 use super::box_filter::box_mean;
+use crate::geometry::ViewId;
 use crate::io::{Raster, Scene};
 use rayon::prelude::*;
 

@@ -20,9 +20,12 @@ pub struct RunResult {
     pub gaussians: Option<GaussianSet>,
     /// The Gaussians' centres at t = 0 in metres, when the scene has a camera.
     pub points: Option<PointCloud>,
-    /// Loss per step, per stage: `(stage name, values)`.
-    pub curves: Vec<(String, Vec<f32>)>,
+    /// Loss per step, per stage.
+    pub curves: LossCurves,
 }
+
+/// Loss per step, per stage: `(stage name, values)`.
+pub type LossCurves = Vec<(String, Vec<f32>)>;
 
 /// A coloured point cloud: the scene at t = 0 in the central camera frame (OpenCV axes, metres).
 #[derive(Debug, Clone, PartialEq)]

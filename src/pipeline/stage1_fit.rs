@@ -6,8 +6,8 @@ use crate::geometry::ViewId;
 use crate::io::{Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
 use crate::model::Gaussians;
-use crate::render::{RenderSettings, bins_for_view, render};
 use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
+use crate::render::{RenderSettings, bins_for_view, render};
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// Learning rates of the four parameter groups (units of the parameter per step).
@@ -74,10 +74,8 @@ pub fn fit_stage1(
     let band = fit.band_height.clamp(1, h);
     let bands: Vec<std::ops::Range<usize>> = (0..h).step_by(band).map(|y| y..(y + band).min(h)).collect();
     // Band targets are cut once: `[P, C]` per (band, view).
-    let band_targets: Vec<Vec<Tensor<2>>> = bands
-        .iter()
-        .map(|rows| targets.iter().map(|t| band_tensor(t.image, rows.clone(), device)).collect())
-        .collect();
+    let band_targets: Vec<Vec<Tensor<2>>> =
+        bands.iter().map(|rows| targets.iter().map(|t| band_tensor(t.image, rows.clone(), device)).collect()).collect();
     let default = GroupPlan { schedule: Schedule::Constant(fit.lr.position), adam_epsilon: fit.adam_epsilon };
     let stage = Stage { iterations: fit.iterations, plan: with_gaussian_groups(Plan::new(default), &g, &fit.lr, fit.adam_epsilon) };
     let objective = |g: &Gaussians, step: usize| {

@@ -4,12 +4,12 @@
 
 use super::aperture::aperture_weights;
 use super::cue_term::CueTerm;
+use super::stage1_fit::{LearningRates, with_gaussian_groups};
 use super::targets::{ViewTarget, band_tensor, view_targets};
 use super::visibility::{explained_mask_moving, masked};
 use crate::geometry::{Camera, TensorCamera, ViewId};
 use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
-use super::stage1_fit::{LearningRates, with_gaussian_groups};
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionParams, ScaleContext, parameter_scales};
 use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
@@ -99,13 +99,8 @@ struct MotionAndScene {
 /// The scales of `model`'s parameters for a scene: one unit moves a point at the Gaussians'
 /// median depth by about one pixel over half the read-out.
 pub fn motion_scales(model: &dyn MotionModel, g: &Gaussians, camera: &Camera) -> Vec<f64> {
-    let mut depths: Vec<f64> = g
-        .to_set()
-        .disparity
-        .iter()
-        .map(|&d| camera.disparity_to_depth(d as f64))
-        .filter(|z| z.is_finite() && *z > 0.0)
-        .collect();
+    let mut depths: Vec<f64> =
+        g.to_set().disparity.iter().map(|&d| camera.disparity_to_depth(d as f64)).filter(|z| z.is_finite() && *z > 0.0).collect();
     depths.sort_by(f64::total_cmp);
     let median = depths.get(depths.len() / 2).copied().unwrap_or(camera.focus_m);
     let ctx = ScaleContext {
@@ -190,19 +185,30 @@ pub fn fit_stage2(
     let initial = MotionAndScene { motion: MotionParams::new(start, &scales, device), gaussians: g };
     let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
     let objective = |m: &MotionAndScene, step: usize| {
-        if masks.is_some() && step > 0 && step % MASK_REFRESH == 0 {
+        if masks.is_some() && step > 0 && step.is_multiple_of(MASK_REFRESH) {
             masks = draw_masks(&model.record(&m.motion.si_values(&scales)));
         }
         let params = m.motion.si(&scales);
         let scaled = m.motion.scaled.val();
-        let joint = Pass { shape: StaticShape::new(&m.gaussians, tc, model, params.clone()), params: params.clone(), weighted: true, prior: true };
+        let joint =
+            Pass { shape: StaticShape::new(&m.gaussians, tc, model, params.clone()), params: params.clone(), weighted: true, prior: true };
         // Under joint refinement an aperture-weighted view is rendered twice: the motion's pass
         // (Gaussians held) compares the weighted residual, the Gaussians' pass (motion held)
         // every pixel, so the geometry still learns from the horizontal edges the motion ignores.
         let split = (fit.refine.is_some() && aperture.iter().any(Option::is_some)).then(|| {
             [
-                Pass { shape: StaticShape::new(&m.gaussians.clone().no_grad(), tc, model, params.clone()), params: params.clone(), weighted: true, prior: true },
-                Pass { shape: StaticShape::new(&m.gaussians, tc, model, params.clone().detach()), params: params.clone().detach(), weighted: false, prior: false },
+                Pass {
+                    shape: StaticShape::new(&m.gaussians.clone().no_grad(), tc, model, params.clone()),
+                    params: params.clone(),
+                    weighted: true,
+                    prior: true,
+                },
+                Pass {
+                    shape: StaticShape::new(&m.gaussians, tc, model, params.clone().detach()),
+                    params: params.clone().detach(),
+                    weighted: false,
+                    prior: false,
+                },
             ]
         });
         let mut loss = MeanLoss::default();

@@ -136,7 +136,9 @@ mod tests {
     /// A smooth 2D texture shifted by (sx, sy): the value at (x, y) is the texture's at (x - sx, y - sy).
     fn texture(w: usize, h: usize, sx: f64, sy: f64) -> Raster {
         // Wavelengths of 25-50 px.
-        let f = |x: f64, y: f64| 0.5 + 0.2 * (0.21 * x + 0.13 * y).sin() + 0.2 * (0.17 * y - 0.09 * x).cos() + 0.1 * (0.12 * x + 0.19 * y).sin();
+        let f = |x: f64, y: f64| {
+            0.5 + 0.2 * (0.21 * x + 0.13 * y).sin() + 0.2 * (0.17 * y - 0.09 * x).cos() + 0.1 * (0.12 * x + 0.19 * y).sin()
+        };
         let data = (0..w * h).map(|i| f((i % w) as f64 - sx, (i / w) as f64 - sy) as f32).collect();
         Raster { width: w, height: h, channels: 1, data }
     }

@@ -1,6 +1,7 @@
 //! The discrete bookkeeping of the renderer, outside autodiff: for each pixel of a band of rows,
 //! the K nearest Gaussians (largest disparity first) whose footprint covers it.
 
+use super::RenderSettings;
 use std::ops::Range;
 
 /// The per-pixel Gaussian lists of one band of one view.
@@ -32,9 +33,11 @@ impl PixelBins {
 }
 
 /// Bins Gaussians with (view-shifted) centres `(u, v)`, disparities `d` and sizes `sigma` over
-/// `rows` of an image `width` wide. A Gaussian covers the pixels within `cutoff * sigma` of its
-/// centre. Each pixel keeps the `k` front-most (largest disparity; ties by index).
-pub fn bin(u: &[f32], v: &[f32], d: &[f32], sigma: &[f32], width: usize, rows: Range<usize>, k: usize, cutoff: f32) -> PixelBins {
+/// `rows` of an image `width` wide. A Gaussian covers the pixels within `settings.cutoff_sigma`
+/// sizes of its centre. Each pixel keeps the `settings.max_per_pixel` front-most (largest
+/// disparity; ties by index).
+pub fn bin(u: &[f32], v: &[f32], d: &[f32], sigma: &[f32], width: usize, rows: Range<usize>, settings: &RenderSettings) -> PixelBins {
+    let (k, cutoff) = (settings.max_per_pixel, settings.cutoff_sigma);
     let p = rows.len() * width;
     let mut indices = vec![0i64; p * k];
     let mut valid = vec![0.0f32; p * k];
@@ -86,8 +89,8 @@ mod tests {
         // Three Gaussians over pixel (2, 1); the far one is dropped with k = 2.
         let (u, v) = ([2.0, 2.2, 1.8], [1.0, 1.1, 0.9]);
         let d = [0.5, 2.0, 1.0];
-        let bins = bin(&u, &v, &d, &[1.0; 3], 5, 0..3, 2, 3.0);
-        let px = 1 * 5 + 2;
+        let bins = bin(&u, &v, &d, &[1.0; 3], 5, 0..3, &RenderSettings { max_per_pixel: 2, cutoff_sigma: 3.0 });
+        let px = 5 + 2; // row 1, column 2
         assert_eq!(&bins.indices[px * 2..px * 2 + 2], &[1, 2]);
         assert_eq!(&bins.valid[px * 2..px * 2 + 2], &[1.0, 1.0]);
         assert!(bins.saturated_fraction() > 0.9);
@@ -95,7 +98,7 @@ mod tests {
 
     #[test]
     fn footprints_are_cut_off_and_bands_are_offset() {
-        let bins = bin(&[10.0], &[10.0], &[0.0], &[1.0], 20, 8..12, 4, 2.0);
+        let bins = bin(&[10.0], &[10.0], &[0.0], &[1.0], 20, 8..12, &RenderSettings { max_per_pixel: 4, cutoff_sigma: 2.0 });
         let at = |x: usize, y: usize| bins.valid[((y - 8) * 20 + x) * 4];
         assert_eq!(at(10, 10), 1.0);
         assert_eq!(at(12, 10), 1.0); // distance 2 = cutoff

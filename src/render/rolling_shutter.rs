@@ -49,12 +49,7 @@ impl StaticShape {
         let observed = camera.lift(u, v.clone(), d.clone());
         let z = camera.depth(d);
         let pose = model.poses(params, camera.row_time(v));
-        Self {
-            points: pose.apply_inverse(observed),
-            radius_m: g.log_size.val().exp() * z / camera.f_px,
-            colour: g.colour.val(),
-            camera,
-        }
+        Self { points: pose.apply_inverse(observed), radius_m: g.log_size.val().exp() * z / camera.f_px, colour: g.colour.val(), camera }
     }
 
     /// The splats of the view at `offset = (c - cc, r - rc)` with every Gaussian at its own time

@@ -76,7 +76,7 @@ impl Splats {
     /// The bins of `rows` of a `width`-pixel-wide view for these splats (read back to the host).
     pub fn bins(&self, width: usize, rows: Range<usize>, settings: &RenderSettings) -> PixelBins {
         let host = |t: &Tensor<1>| t.clone().into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
-        bin(&host(&self.u), &host(&self.v), &host(&self.disparity), &host(&self.sigma), width, rows, settings.max_per_pixel, settings.cutoff_sigma)
+        bin(&host(&self.u), &host(&self.v), &host(&self.disparity), &host(&self.sigma), width, rows, settings)
     }
 }
 
@@ -85,7 +85,7 @@ impl Splats {
 pub fn bins_for_view(set: &GaussianSet, offset: (f32, f32), width: usize, rows: Range<usize>, settings: &RenderSettings) -> PixelBins {
     let u: Vec<f32> = set.u.iter().zip(&set.disparity).map(|(u, d)| u - offset.0 * d).collect();
     let v: Vec<f32> = set.v.iter().zip(&set.disparity).map(|(v, d)| v - offset.1 * d).collect();
-    bin(&u, &v, &set.disparity, &set.size, width, rows, settings.max_per_pixel, settings.cutoff_sigma)
+    bin(&u, &v, &set.disparity, &set.size, width, rows, settings)
 }
 
 /// Blends `splats` over the pixels of `bins`, front to back.
@@ -93,8 +93,7 @@ pub fn splat(s: &Splats, bins: &PixelBins, device: &Device) -> RenderOutput {
     let (p, k, c) = (bins.pixels(), bins.k, s.colour.dims()[1]);
     let index = Tensor::<1, Int>::from_data(TensorData::new(bins.indices.clone(), [p * k]), device);
     let valid = Tensor::<2>::from_data(TensorData::new(bins.valid.clone(), [p, k]), device);
-    let (xs, ys): (Vec<f32>, Vec<f32>) =
-        (0..p).map(|i| ((i % bins.width) as f32, (bins.rows.start + i / bins.width) as f32)).unzip();
+    let (xs, ys): (Vec<f32>, Vec<f32>) = (0..p).map(|i| ((i % bins.width) as f32, (bins.rows.start + i / bins.width) as f32)).unzip();
     let px = Tensor::<2>::from_data(TensorData::new(xs, [p, 1]), device);
     let py = Tensor::<2>::from_data(TensorData::new(ys, [p, 1]), device);
 
@@ -121,7 +120,14 @@ pub fn render(g: &Gaussians, offset: (f32, f32), bins: &PixelBins, device: &Devi
 }
 
 /// Bins and renders `rows` of the view at `offset` in one call.
-pub fn render_rows(g: &Gaussians, offset: (f32, f32), width: usize, rows: Range<usize>, settings: &RenderSettings, device: &Device) -> RenderOutput {
+pub fn render_rows(
+    g: &Gaussians,
+    offset: (f32, f32),
+    width: usize,
+    rows: Range<usize>,
+    settings: &RenderSettings,
+    device: &Device,
+) -> RenderOutput {
     let bins = bins_for_view(&g.to_set(), offset, width, rows, settings);
     render(g, offset, &bins, device)
 }

@@ -146,7 +146,7 @@ impl SceneDescription {
 
     fn validate(&self) -> Result<(), String> {
         let c = &self.camera;
-        if c.num_cams % 2 == 0 || c.num_cams == 0 {
+        if c.num_cams.is_multiple_of(2) || c.num_cams == 0 {
             return Err(format!("[camera] num_cams = {} must be odd", c.num_cams));
         }
         if c.size[0] < 8 || c.size[1] < 8 || c.size[0] > 8192 || c.size[1] > 8192 {

@@ -22,8 +22,7 @@ impl<'a> Capture<'a> {
     /// A capture of `world` by `camera` under `motion` (zero motion: global shutter).
     pub fn new(world: &'a World, camera: &'a Camera, motion: &MotionRecord) -> Self {
         let readout = readout_interval(camera.height, camera.line_time_s);
-        let row_inverse =
-            (0..camera.height).map(|y| pose_at(motion, camera.row_time(y as f64), readout).inverse()).collect();
+        let row_inverse = (0..camera.height).map(|y| pose_at(motion, camera.row_time(y as f64), readout).inverse()).collect();
         Self { world, camera, row_inverse, motion: motion.clone() }
     }
 
@@ -43,11 +42,7 @@ impl<'a> Capture<'a> {
     fn ray_with(&self, view: ViewId, px: f64, py: f64, inv: &Pose) -> (Point3<f64>, Vector3<f64>) {
         let cam = self.camera;
         let c = cam.view_centre(view);
-        let dir = Vector3::new(
-            (px - cam.u0()) / cam.f_px - c.x / cam.focus_m,
-            (py - cam.v0()) / cam.f_px - c.y / cam.focus_m,
-            1.0,
-        );
+        let dir = Vector3::new((px - cam.u0()) / cam.f_px - c.x / cam.focus_m, (py - cam.v0()) / cam.f_px - c.y / cam.focus_m, 1.0);
         (inv.apply(&Point3::from(c)), inv.rotation * dir)
     }
 

@@ -5,9 +5,7 @@ use super::render::Capture;
 use super::truth::{Truth, ground_truth};
 use super::world::World;
 use crate::geometry::Camera;
-use crate::io::{
-    IoResult, MotionRecord, Raster, SceneParameters, view_file_name, write_folder, write_mask_png, write_pfm, write_png,
-};
+use crate::io::{IoResult, MotionRecord, Raster, SceneParameters, view_file_name, write_folder, write_mask_png, write_pfm, write_png};
 use std::path::Path;
 
 /// Overrides of a description for one generation.

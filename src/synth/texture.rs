@@ -57,7 +57,8 @@ fn lerp(a: &Rgb, b: &Rgb, t: f64) -> Rgb {
 
 /// A pseudo-random unit-ish gradient at lattice point (i, j, k).
 fn gradient(i: i64, j: i64, k: i64, seed: u64) -> Vector3<f64> {
-    let h = hash64((i as u64).wrapping_mul(0x8DA6_B343) ^ (j as u64).wrapping_mul(0xD816_3841) ^ (k as u64).wrapping_mul(0xCB1A_B31F) ^ seed);
+    let h =
+        hash64((i as u64).wrapping_mul(0x8DA6_B343) ^ (j as u64).wrapping_mul(0xD816_3841) ^ (k as u64).wrapping_mul(0xCB1A_B31F) ^ seed);
     let c = |s: u32| ((h >> s) & 0xFFFF) as f64 / 32767.5 - 1.0;
     Vector3::new(c(0), c(16), c(32))
 }
@@ -69,9 +70,8 @@ pub fn gradient_noise(p: &Point3<f64>, seed: u64) -> f64 {
     let (x, y, z) = (p.x - fx, p.y - fy, p.z - fz);
     let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
     let (u, v, w) = (fade(x), fade(y), fade(z));
-    let corner = |di: i64, dj: i64, dk: i64| {
-        gradient(i + di, j + dj, k + dk, seed).dot(&Vector3::new(x - di as f64, y - dj as f64, z - dk as f64))
-    };
+    let corner =
+        |di: i64, dj: i64, dk: i64| gradient(i + di, j + dj, k + dk, seed).dot(&Vector3::new(x - di as f64, y - dj as f64, z - dk as f64));
     let l = |a: f64, b: f64, t: f64| a + (b - a) * t;
     let x00 = l(corner(0, 0, 0), corner(1, 0, 0), u);
     let x10 = l(corner(0, 1, 0), corner(1, 1, 0), u);
@@ -118,7 +118,8 @@ impl Texture {
 
     /// Checks the parameters; the error names the field.
     pub fn validate(&self) -> Result<(), String> {
-        let positive = |name: &str, v: f64| if v > 0.0 && v.is_finite() { Ok(()) } else { Err(format!("texture `{name}` must be positive")) };
+        let positive =
+            |name: &str, v: f64| if v > 0.0 && v.is_finite() { Ok(()) } else { Err(format!("texture `{name}` must be positive")) };
         match self {
             Texture::Checker { size, .. } => positive("size", *size),
             Texture::Noise { scale, octaves, .. } => {

@@ -93,10 +93,10 @@ impl World {
             let inv = obj.rotation.inverse();
             let ol = Point3::from(inv * oc);
             let dl = inv * d;
-            if let Some(h) = obj.shape.intersect(&ol, &dl, &obj.segments) {
-                if best.is_none_or(|(t, ..)| h.t < t) {
-                    best = Some((h.t, i, h.normal, ol + dl * h.t));
-                }
+            if let Some(h) = obj.shape.intersect(&ol, &dl, &obj.segments)
+                && best.is_none_or(|(t, ..)| h.t < t)
+            {
+                best = Some((h.t, i, h.normal, ol + dl * h.t));
             }
         }
         let (t, i, normal, local) = best?;

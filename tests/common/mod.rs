@@ -52,7 +52,15 @@ pub fn write_plane_scene(dir: &Path, w: usize, h: usize, n: usize, d: f64, keep:
 
 /// [`write_plane_scene`] with another texture.
 #[allow(dead_code)]
-pub fn write_plane_scene_with(dir: &Path, w: usize, h: usize, n: usize, d: f64, keep: impl Fn(usize) -> bool, texture: impl Fn(f64, f64, usize) -> f32) {
+pub fn write_plane_scene_with(
+    dir: &Path,
+    w: usize,
+    h: usize,
+    n: usize,
+    d: f64,
+    keep: impl Fn(usize) -> bool,
+    texture: impl Fn(f64, f64, usize) -> f32,
+) {
     std::fs::create_dir_all(dir).unwrap();
     let cc = (n as f64 - 1.0) / 2.0;
     for r in 0..n {

@@ -15,7 +15,8 @@ impl MotionModel for ConstantAcceleration {
     }
 
     fn parameters(&self) -> Vec<ParamKind> {
-        [ParamKind::velocities(), ParamKind::xyz(Quantity::Rotation, 2).to_vec(), ParamKind::xyz(Quantity::Translation, 2).to_vec()].concat()
+        [ParamKind::velocities(), ParamKind::xyz(Quantity::Rotation, 2).to_vec(), ParamKind::xyz(Quantity::Translation, 2).to_vec()]
+            .concat()
     }
 
     fn poses(&self, params: Tensor<1>, times: Tensor<1>) -> PoseBatch {
@@ -39,7 +40,9 @@ impl MotionModel for ConstantAcceleration {
             MotionRecord::ConstantAcceleration { omega_rad_s, velocity_m_s, alpha_rad_s2, accel_m_s2 } => {
                 Some([*omega_rad_s, *velocity_m_s, *alpha_rad_s2, *accel_m_s2].concat())
             }
-            MotionRecord::ConstantVelocity { omega_rad_s, velocity_m_s } => Some([*omega_rad_s, *velocity_m_s, [0.0; 3], [0.0; 3]].concat()),
+            MotionRecord::ConstantVelocity { omega_rad_s, velocity_m_s } => {
+                Some([*omega_rad_s, *velocity_m_s, [0.0; 3], [0.0; 3]].concat())
+            }
             _ => None,
         }
     }

@@ -19,10 +19,7 @@ impl MotionModel for ConstantVelocity {
     }
 
     fn poses(&self, params: Tensor<1>, times: Tensor<1>) -> PoseBatch {
-        PoseBatch {
-            rotation: rotation_matrices(scale_rows(&times, vec3(&params, 0))),
-            translation: scale_rows(&times, vec3(&params, 3)),
-        }
+        PoseBatch { rotation: rotation_matrices(scale_rows(&times, vec3(&params, 0))), translation: scale_rows(&times, vec3(&params, 3)) }
     }
 
     fn record(&self, p: &[f64]) -> MotionRecord {

@@ -13,7 +13,6 @@ pub use constant_velocity::ConstantVelocity;
 pub use piecewise_constant::PiecewiseConstant;
 pub use registry::{MotionConstructor, MotionRegistry, MotionSetup, UnknownMotion};
 
-
 use crate::geometry::PoseBatch;
 use crate::io::MotionRecord;
 use burn::module::{Module, Param};
@@ -139,7 +138,7 @@ pub fn parameter_scales(kinds: &[ParamKind], ctx: &ScaleContext) -> Vec<f64> {
 
 /// Entries `at..at + 3` of a parameter vector as a `[1, 3]` row.
 pub fn vec3(params: &Tensor<1>, at: usize) -> Tensor<2> {
-    params.clone().slice([at..at + 3]).reshape([1, 3])
+    params.clone().slice(at..at + 3).reshape([1, 3])
 }
 
 /// `times ⊗ row`: `[N]` times a `[1, 3]` row gives `[N, 3]`.

@@ -84,7 +84,9 @@ impl MotionModel for PiecewiseConstant {
             MotionRecord::PiecewiseConstant { omega_rad_s, velocity_m_s } if omega_rad_s.len() == self.segments => {
                 Some(omega_rad_s.iter().zip(velocity_m_s).flat_map(|(w, v)| [*w, *v].concat()).collect())
             }
-            MotionRecord::ConstantVelocity { omega_rad_s, velocity_m_s } => Some([*omega_rad_s, *velocity_m_s].concat().repeat(self.segments)),
+            MotionRecord::ConstantVelocity { omega_rad_s, velocity_m_s } => {
+                Some([*omega_rad_s, *velocity_m_s].concat().repeat(self.segments))
+            }
             _ => None,
         }
     }
