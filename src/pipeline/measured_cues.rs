@@ -12,10 +12,12 @@
 //! photometric fit alone compares the corners with renders of the stage-1 model, whose errors
 //! there are far larger than `μ` (docs/results.md).
 
-use super::view_tracking::{TrackSettings, textured_points, track};
+use super::view_tracking::{TrackSettings, textured_points, track_warped};
 use crate::geometry::{Camera, ViewId, pose_at, readout_interval, rs_project};
 use crate::io::{MotionRecord, Raster, Scene};
+use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
 /// it sits in one corner view against where its disparity alone would put it.
@@ -37,6 +39,15 @@ pub struct Cue {
 /// view, e.g. the plane sweep's) only starts the tracking. Patches lost in either view, or found
 /// more than 0.25 px up or down in the central view (the row views are read at the same time,
 /// so that is a mismatch), are left out. Corners or row views the scene lacks give no cues.
+///
+/// A patch on a surface slanted in depth is sheared between row views and stretched between
+/// a row view and a corner by its disparity gradient, and a translation-only match of a
+/// deformed patch lands where its gradient energy is centred, which differs between the
+/// horizontal match that gives `d` and the vertical one that gives `μ`: on a receding floor that
+/// biases every `μ` the same way. So the tracking is done twice: a first pass gives each patch's
+/// disparity, a plane fitted to its neighbours' gives the local gradient, and the second pass
+/// matches with the deformation that gradient predicts ([`track_warped`]). Patches whose
+/// neighbours fit no plane (a depth edge, a bad match) are left out too.
 pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
     let grid = scene.grid;
     let (Some(centre), w, h) = (grid.central(), scene.width(), scene.height()) else { return Vec::new() };
@@ -58,21 +69,33 @@ pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
         }
         let row_img = row_img.to_grey();
         let points = textured_points(&row_img, settings.radius, stride, 0.1);
+        // The patch of the row view, found in the central view `a d` to the right: `d`.
+        let to_centre = |(x, y): (usize, usize), start: f64, slope: (f64, f64)| {
+            let linear = [[a * slope.0, a * slope.1], [0.0, 0.0]];
+            let found = track_warped(&row_img, &central, (x, y), (a * start, 0.0), linear, &settings)?.displacement;
+            (found.1.abs() <= 0.25).then_some(found.0 / a)
+        };
+        let first: Vec<Option<f64>> = points
+            .par_iter()
+            .map(|&(x, y)| {
+                let gx = ((x as f64 + a * guess_d0(guess, x, y)?).round().max(0.0) as usize).min(w - 1);
+                to_centre((x, y), guess_d0(guess, gx, y)?, (0.0, 0.0))
+            })
+            .collect();
+        let first = PatchDisparities::new(&points, &first);
+        // The neighbours a gradient is fitted to: those within a patch, or two grid steps.
+        let reach = settings.radius.max(2 * stride);
         let found: Vec<Vec<Cue>> = points
             .par_iter()
-            .filter_map(|&(x, y)| {
-                let gx = ((x as f64 + a * guess_d0(guess, x, y)?).round().max(0.0) as usize).min(w - 1);
-                let d0 = guess_d0(guess, gx, y)?;
-                // The patch of the row view, found in the central view `a d` to the right: `d`.
-                let to_centre = track(&row_img, &central, (x, y), (a * d0, 0.0), &settings)?;
-                if to_centre.displacement.1.abs() > 0.25 {
-                    return None;
-                }
-                let d = to_centre.displacement.0 / a;
+            .zip(&first.values)
+            .filter_map(|(&(x, y), &d1)| {
+                let slope = first.slope_at((x, y), reach)?;
+                let d = to_centre((x, y), d1?, slope)?;
                 // The same patch in each corner of its column: `b d` rows up or down, and `μ`.
                 let in_corners = corners.iter().filter_map(|(view, image)| {
                     let b = grid.offset(*view).1;
-                    let (dx, dy) = track(&row_img, image, (x, y), (0.0, -b * d), &settings)?.displacement;
+                    let linear = [[0.0, 0.0], [-b * slope.0, -b * slope.1]];
+                    let (dx, dy) = track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, &settings)?.displacement;
                     Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d) })
                 });
                 Some(in_corners.collect())
@@ -81,6 +104,52 @@ pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
         cues.extend(found.into_iter().flatten());
     }
     cues
+}
+
+/// The first-pass disparities of the patches, looked up by position.
+struct PatchDisparities {
+    values: Vec<Option<f64>>,
+    at: HashMap<(usize, usize), usize>,
+}
+
+impl PatchDisparities {
+    fn new(points: &[(usize, usize)], values: &[Option<f64>]) -> Self {
+        Self { values: values.to_vec(), at: points.iter().enumerate().map(|(i, &p)| (p, i)).collect() }
+    }
+
+    /// The disparity gradient `(∂d/∂x, ∂d/∂y)` at `p`: the least-squares plane through the
+    /// disparities of the patches within `radius` px each way. `None` with fewer than eight of
+    /// them, when they do not span both directions, or when they lie off the plane by more than
+    /// 0.05 px RMS.
+    fn slope_at(&self, p: (usize, usize), radius: usize) -> Option<(f64, f64)> {
+        let r = radius as isize;
+        let near: Vec<(f64, f64, f64)> = (-r..=r)
+            .flat_map(|dy| (-r..=r).map(move |dx| (dx, dy)))
+            .filter_map(|(dx, dy)| {
+                let q = (p.0.checked_add_signed(dx)?, p.1.checked_add_signed(dy)?);
+                Some((dx as f64, dy as f64, (*self.values.get(*self.at.get(&q)?)?)?))
+            })
+            .collect();
+        if near.len() < 8 {
+            return None;
+        }
+        let (mut normal, mut rhs) = (Matrix3::<f64>::zeros(), Vector3::<f64>::zeros());
+        for &(x, y, d) in &near {
+            let row = Vector3::new(1.0, x, y);
+            normal += row * row.transpose();
+            rhs += row * d;
+        }
+        // Both directions spanned: the offsets' covariance is well away from singular.
+        let n = near.len() as f64;
+        let (mx, my) = (normal[(0, 1)] / n, normal[(0, 2)] / n);
+        let (vx, vy, cxy) = (normal[(1, 1)] / n - mx * mx, normal[(2, 2)] / n - my * my, normal[(1, 2)] / n - mx * my);
+        if vx * vy - cxy * cxy < 0.25 * (radius as f64).powi(4) / 9.0 {
+            return None;
+        }
+        let plane = normal.lu().solve(&rhs)?;
+        let rms = (near.iter().map(|&(x, y, d)| (plane[0] + plane[1] * x + plane[2] * y - d).powi(2)).sum::<f64>() / n).sqrt();
+        (rms <= 0.05).then_some((plane[1], plane[2]))
+    }
 }
 
 /// The guess's disparity at (x, y), when finite.
@@ -103,4 +172,39 @@ pub fn predicted_cue(camera: &Camera, estimate: &MotionRecord, cue: &Cue) -> Opt
     let moved = rs_project(camera, estimate, cue.view, &at_zero)?;
     let still = rs_project(camera, &MotionRecord::zero(), cue.view, &seen)?;
     Some((moved.0 - still.0, moved.1 - still.1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Patches every 2 px over a 40 x 40 area, with disparities `d(x, y)`.
+    fn patches(d: impl Fn(f64, f64) -> f64) -> PatchDisparities {
+        let points: Vec<(usize, usize)> = (0..20).flat_map(|j| (0..20).map(move |i| (10 + 2 * i, 10 + 2 * j))).collect();
+        let values: Vec<Option<f64>> = points.iter().map(|&(x, y)| Some(d(x as f64, y as f64))).collect();
+        PatchDisparities::new(&points, &values)
+    }
+
+    #[test]
+    fn the_disparity_gradient_is_the_plane_through_the_neighbours() {
+        let slanted = patches(|x, y| 0.3 + 0.01 * x - 0.02 * y);
+        let (sx, sy) = slanted.slope_at((30, 30), 4).unwrap();
+        assert!((sx - 0.01).abs() < 1e-9 && (sy + 0.02).abs() < 1e-9, "{sx} {sy}");
+        // Beyond the corner of the area only four patches lie within reach.
+        assert!(slanted.slope_at((8, 8), 4).is_none());
+    }
+
+    #[test]
+    fn a_depth_edge_or_a_sparse_neighbourhood_gives_no_gradient() {
+        // A foreground half 0.5 px nearer than the background: no plane fits across it.
+        let edge = patches(|x, _| if x < 30.0 { 0.5 } else { 0.0 });
+        assert!(edge.slope_at((30, 30), 4).is_none());
+        assert!(edge.slope_at((20, 30), 4).is_some());
+        // Neighbours on one row only do not fix the vertical gradient.
+        let row = PatchDisparities::new(
+            &[(8, 20), (10, 20), (12, 20), (14, 20), (16, 20), (6, 20), (4, 20), (18, 20), (20, 20)],
+            &[Some(0.1); 9],
+        );
+        assert!(row.slope_at((12, 20), 4).is_none());
+    }
 }

@@ -356,7 +356,7 @@ fn stage2(
         let start = Instant::now();
         let cues = measure_cues(scene, initial_disparity);
         log.lines.push(format!(
-            "stage 2 cues: {} textured patches tracked from the central-row views of the corners' columns into the central view and the corners, {:.1} s",
+            "stage 2 cues: {} measured, textured patches of the central-row views of the corners' columns tracked into the central view and the corners, {:.1} s",
             cues.len(),
             start.elapsed().as_secs_f64()
         ));

@@ -92,6 +92,22 @@ pub fn textured_points(grey: &Raster, radius: usize, stride: usize, share: f64) 
 /// image, the iteration does not settle, or it ends farther than `settings.max_correction`
 /// from the guess.
 pub fn track(from: &Raster, to: &Raster, at: (usize, usize), guess: (f64, f64), settings: &TrackSettings) -> Option<Track> {
+    track_warped(from, to, at, guess, [[0.0; 2]; 2], settings)
+}
+
+/// [`track`] for a patch that also deforms by a known linear map: the pixel at offset `o` from
+/// the centre moves by the tracked displacement plus `linear · o`. Only the displacement is
+/// estimated. A surface slanted in depth stretches or shears a patch between views by its
+/// disparity gradient; a translation-only match then lands where the patch's gradient energy
+/// is centred, not at its centre, which differs between horizontal and vertical matches.
+pub fn track_warped(
+    from: &Raster,
+    to: &Raster,
+    at: (usize, usize),
+    guess: (f64, f64),
+    linear: [[f64; 2]; 2],
+    settings: &TrackSettings,
+) -> Option<Track> {
     let r = settings.radius;
     if (from.width, from.height) != (to.width, to.height) {
         return None;
@@ -104,11 +120,13 @@ pub fn track(from: &Raster, to: &Raster, at: (usize, usize), guess: (f64, f64), 
     if det <= 1e-18 * (sxx + syy).powi(2).max(1e-30) {
         return None;
     }
+    let [[l00, l01], [l10, l11]] = linear;
     let (mut dx, mut dy) = guess;
     for _ in 0..settings.iterations {
         let (mut bx, mut by, mut ss) = (0.0, 0.0, 0.0);
         for &(ox, oy, t, gx, gy) in &template {
-            let s = to.sample_bilinear((x0 as f64 + ox + dx) as f32, (y0 as f64 + oy + dy) as f32, 0)? as f64;
+            let (wx, wy) = (ox + l00 * ox + l01 * oy, oy + l10 * ox + l11 * oy);
+            let s = to.sample_bilinear((x0 as f64 + wx + dx) as f32, (y0 as f64 + wy + dy) as f32, 0)? as f64;
             let e = s - t;
             bx += gx * e;
             by += gy * e;
@@ -152,6 +170,27 @@ mod tests {
         // amplitude, which moves the match by up to about ω/8 px: here about 0.03 px.
         assert!((t.displacement.0 - 2.37).abs() < 0.05 && (t.displacement.1 + 1.62).abs() < 0.05, "{t:?}");
         assert!(t.residual_rms < 3e-3, "{t:?}");
+    }
+
+    #[test]
+    fn a_stretched_patch_is_found_at_its_centre_when_the_stretch_is_known() {
+        // A texture whose contrast grows down the patch, stretched vertically by 8 % about the
+        // patch centre (32, 32) and moved by (0.4, -2.3): the vertical parallax of a receding
+        // floor between a row view and a corner.
+        let (c, stretch, shift) = (32.0, 0.08, (0.4, -2.3));
+        let f = |x: f64, y: f64| 0.5 + (0.05 + 0.02 * (y - c).max(-2.5)) * ((0.9 * x + 0.4 * y).sin() + (1.1 * y - 0.3 * x).cos());
+        let image = |g: &dyn Fn(f64, f64) -> f64| {
+            let data = (0..64 * 64).map(|i| g((i % 64) as f64, (i / 64) as f64) as f32).collect();
+            Raster { width: 64, height: 64, channels: 1, data }
+        };
+        let from = image(&f);
+        let to = image(&|x, y| f(x - shift.0, c + (y - c - shift.1) / (1.0 + stretch)));
+        let settings = TrackSettings::default();
+        let plain = track(&from, &to, (32, 32), (0.0, -2.0), &settings).unwrap().displacement;
+        let warped = track_warped(&from, &to, (32, 32), (0.0, -2.0), [[0.0, 0.0], [0.0, stretch]], &settings).unwrap().displacement;
+        let miss = |d: (f64, f64)| (d.0 - shift.0).hypot(d.1 - shift.1);
+        assert!(miss(warped) < 0.02, "warped {warped:?}");
+        assert!(miss(plain) > 3.0 * miss(warped), "translation only {plain:?}, warped {warped:?}");
     }
 
     #[test]
