@@ -135,6 +135,9 @@ impl Config {
         if !(self.stage2.cue_weight >= 0.0 && self.stage2.cue_weight.is_finite()) {
             return fail("stage2.cue_weight", "must be a finite number >= 0");
         }
+        if !(0.0..=1.0).contains(&self.stage2.min_cue_support) {
+            return fail("stage2.min_cue_support", "must be between 0 and 1");
+        }
         if self.motion.model.is_empty() {
             return fail("motion.model", "must name a motion model");
         }
@@ -217,5 +220,7 @@ mod tests {
         assert_eq!(err.key.as_deref(), Some("stage2.disocclusion_margin"));
         let err = parse("[stage2]\ncue_weight = -0.5\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.cue_weight"));
+        let err = parse("[stage2]\nmin_cue_support = 1.5\n").unwrap_err();
+        assert_eq!(err.key.as_deref(), Some("stage2.min_cue_support"));
     }
 }

@@ -196,6 +196,12 @@ pub struct Stage2Config {
     /// disparity alone puts it; the term is the mean Huber penalty (px) of the motion's
     /// predicted cues against those.
     pub cue_weight: f64,
+    /// The least support (0..1) the cues measured between the views must give the estimated
+    /// motion for it to be kept: the noise-weighted least-squares scale of the estimate's
+    /// predicted cues that fits the measured ones (1: borne out, 0: no such motion seen). Below
+    /// it the estimate is taken for a drift of the photometric fit and no motion is kept. 0 = no
+    /// check.
+    pub min_cue_support: f64,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
     pub initial_motion: Option<PathBuf>,
@@ -218,6 +224,7 @@ impl Default for Stage2Config {
             disocclusion_margin: 2,
             aperture_weighting: false,
             cue_weight: 0.0,
+            min_cue_support: 0.5,
             initial_motion: None,
         }
     }

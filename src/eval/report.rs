@@ -91,10 +91,14 @@ impl fmt::Display for EvalReport {
                 let views: Vec<String> = i.per_view_px.iter().map(|(v, e)| format!("{v}: {}", num(*e, 3))).collect();
                 writeln!(
                     f,
-                    "motion     image-space RMS error {} px (true RS shift {} px, {:.1}% of it) over {} points; per view {}",
+                    "motion     image-space RMS error {} px (true RS shift {} px, {} of it) over {} points; per view {}",
                     num(i.rms_error_px, 3),
                     num(i.rms_true_shift_px, 3),
-                    100.0 * i.rms_error_px / i.rms_true_shift_px,
+                    if i.rms_true_shift_px > 0.0 {
+                        format!("{:.1}%", 100.0 * i.rms_error_px / i.rms_true_shift_px)
+                    } else {
+                        "n/a".to_string()
+                    },
                     i.points,
                     views.join(", ")
                 )?;

@@ -3,6 +3,7 @@
 
 mod aperture;
 mod box_filter;
+mod cue_support;
 mod cue_term;
 mod gaussian_init;
 mod light_field;
@@ -16,6 +17,7 @@ mod view_tracking;
 mod visibility;
 
 pub use aperture::aperture_weights;
+pub use cue_support::{CueSupport, cue_support};
 pub use cue_term::CueTerm;
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
@@ -352,7 +354,7 @@ fn stage2(
     log: &mut RunLog,
 ) -> MotionFit {
     let s = &config.stage2;
-    let cue_term = (s.cue_weight > 0.0).then(|| {
+    let cues = (s.cue_weight > 0.0 || s.min_cue_support > 0.0).then(|| {
         let start = Instant::now();
         let cues = measure_cues(scene, initial_disparity);
         log.lines.push(format!(
@@ -360,8 +362,12 @@ fn stage2(
             cues.len(),
             start.elapsed().as_secs_f64()
         ));
-        CueTerm::new(&cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, device)
+        cues
     });
+    let cue_term = cues
+        .as_ref()
+        .filter(|_| s.cue_weight > 0.0)
+        .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, device));
     let mut views = stage2_views(scene, s.views);
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
@@ -386,7 +392,7 @@ fn stage2(
     };
     let bar = crate::progress::bar(s.iterations as u64, "stage 2: motion");
     let start = Instant::now();
-    let fitted = fit_stage2(
+    let mut fitted = fit_stage2(
         gaussians,
         scene,
         camera,
@@ -424,7 +430,31 @@ fn stage2(
         fitted.curve.last().copied().unwrap_or(f32::NAN),
         start.elapsed().as_secs_f64()
     ));
+    if let Some(cues) = cues.as_ref().filter(|_| s.min_cue_support > 0.0) {
+        check_motion(&mut fitted, model, camera, cues, s.min_cue_support, log);
+    }
     fitted
+}
+
+/// Keeps the fitted motion only if the cues measured between the views give it at least
+/// `min_support` ([`cue_support`]); else sets it to no motion, and says which in the log.
+fn check_motion(fitted: &mut MotionFit, model: &dyn MotionModel, camera: &Camera, cues: &[Cue], min_support: f64, log: &mut RunLog) {
+    match cue_support(camera, &model.record(&fitted.parameters), cues) {
+        Some(support) if support.share < min_support => {
+            fitted.parameters.iter_mut().for_each(|p| *p = 0.0);
+            log.lines.push(format!(
+                "stage 2 check: the {} measured cues bear out {:.2} (± {:.2}) of the motion's predicted ones, under {min_support}: taken for a drift of the fit, no motion kept",
+                support.cues, support.share, support.standard_error
+            ));
+        }
+        Some(support) => log.lines.push(format!(
+            "stage 2 check: the {} measured cues bear out {:.2} (± {:.2}) of the motion's predicted ones (at least {min_support} kept)",
+            support.cues, support.share, support.standard_error
+        )),
+        None => {
+            log.lines.push(format!("stage 2 check: not made ({} measured cues; at least 100 imaged and a motion are needed)", cues.len()))
+        }
+    }
 }
 
 /// The plane sweep over the central row (and the stage-1 views of the central column): the
