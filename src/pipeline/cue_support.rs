@@ -6,6 +6,8 @@
 //! The measured cues owe nothing to that model. The support of an estimate is the robust,
 //! noise-weighted least-squares scale `s` that best fits `s × predicted` to the measured cues:
 //! about 1 when they show the motion the estimate predicts, about 0 when they show none of it.
+//! Stage 2 sets a motion to none only when its support is clearly under a threshold
+//! ([`CueSupport::refutes`]).
 
 use super::measured_cues::{Cue, predicted_cue};
 use crate::geometry::Camera;
@@ -25,6 +27,15 @@ pub struct CueSupport {
     pub standard_error: f64,
     /// Cues used.
     pub cues: usize,
+}
+
+impl CueSupport {
+    /// Whether the cues refute a motion at the threshold `min_share`: its support lies under
+    /// it by more than two standard errors. A motion whose cues are too small to judge (few
+    /// cues, little disparity) is never refuted.
+    pub fn refutes(&self, min_share: f64) -> bool {
+        self.share + 2.0 * self.standard_error < min_share
+    }
 }
 
 /// The support `cues` give `estimate` on a scene seen by `camera`: each component of each cue

@@ -436,19 +436,19 @@ fn stage2(
     fitted
 }
 
-/// Keeps the fitted motion only if the cues measured between the views give it at least
-/// `min_support` ([`cue_support`]); else sets it to no motion, and says which in the log.
+/// Sets the fitted motion to none when the cues measured between the views refute it at
+/// `min_support` ([`CueSupport::refutes`]), and says in the log what they show either way.
 fn check_motion(fitted: &mut MotionFit, model: &dyn MotionModel, camera: &Camera, cues: &[Cue], min_support: f64, log: &mut RunLog) {
     match cue_support(camera, &model.record(&fitted.parameters), cues) {
-        Some(support) if support.share < min_support => {
+        Some(support) if support.refutes(min_support) => {
             fitted.parameters.iter_mut().for_each(|p| *p = 0.0);
             log.lines.push(format!(
-                "stage 2 check: the {} measured cues bear out {:.2} (± {:.2}) of the motion's predicted ones, under {min_support}: taken for a drift of the fit, no motion kept",
+                "stage 2 check: the {} measured cues bear out {:.2} (± {:.2}) of the motion's predicted ones, clearly under {min_support}: taken for a drift of the fit, no motion kept",
                 support.cues, support.share, support.standard_error
             ));
         }
         Some(support) => log.lines.push(format!(
-            "stage 2 check: the {} measured cues bear out {:.2} (± {:.2}) of the motion's predicted ones (at least {min_support} kept)",
+            "stage 2 check: the {} measured cues bear out {:.2} (± {:.2}) of the motion's predicted ones, not clearly under {min_support}: kept",
             support.cues, support.share, support.standard_error
         )),
         None => {
