@@ -354,7 +354,9 @@ fn stage2(
     log: &mut RunLog,
 ) -> MotionFit {
     let s = &config.stage2;
-    let cues = (s.cue_weight > 0.0 || s.min_cue_support > 0.0).then(|| {
+    // The cue check judges a fitted motion; a motion given with no iterations is used as it is.
+    let check = s.min_cue_support > 0.0 && s.iterations > 0;
+    let cues = (s.cue_weight > 0.0 || check).then(|| {
         let start = Instant::now();
         let cues = measure_cues(scene, initial_disparity);
         log.lines.push(format!(
@@ -430,7 +432,7 @@ fn stage2(
         fitted.curve.last().copied().unwrap_or(f32::NAN),
         start.elapsed().as_secs_f64()
     ));
-    if let Some(cues) = cues.as_ref().filter(|_| s.min_cue_support > 0.0) {
+    if let Some(cues) = cues.as_ref().filter(|_| check) {
         check_motion(&mut fitted, model, camera, cues, s.min_cue_support, log);
     }
     fitted
