@@ -82,7 +82,7 @@ pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
                 to_centre((x, y), guess_d0(guess, gx, y)?, (0.0, 0.0))
             })
             .collect();
-        let first = PatchDisparities::new(&points, &first);
+        let first = PatchDisparities::new(&points, first, stride);
         // The neighbours a gradient is fitted to: those within a patch, or two grid steps.
         let reach = settings.radius.max(2 * stride);
         let found: Vec<Vec<Cue>> = points
@@ -110,11 +110,13 @@ pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
 struct PatchDisparities {
     values: Vec<Option<f64>>,
     at: HashMap<(usize, usize), usize>,
+    /// The step of the grid the patches lie on (px).
+    step: usize,
 }
 
 impl PatchDisparities {
-    fn new(points: &[(usize, usize)], values: &[Option<f64>]) -> Self {
-        Self { values: values.to_vec(), at: points.iter().enumerate().map(|(i, &p)| (p, i)).collect() }
+    fn new(points: &[(usize, usize)], values: Vec<Option<f64>>, step: usize) -> Self {
+        Self { values, at: points.iter().enumerate().map(|(i, &p)| (p, i)).collect(), step: step.max(1) }
     }
 
     /// The disparity gradient `(∂d/∂x, ∂d/∂y)` at `p`: the least-squares plane through the
@@ -122,9 +124,11 @@ impl PatchDisparities {
     /// them, when they do not span both directions, or when they lie off the plane by more than
     /// 0.05 px RMS.
     fn slope_at(&self, p: (usize, usize), radius: usize) -> Option<(f64, f64)> {
-        let r = radius as isize;
+        // Only grid points can hold a patch.
+        let (r, step) = ((radius / self.step * self.step) as isize, self.step);
         let near: Vec<(f64, f64, f64)> = (-r..=r)
-            .flat_map(|dy| (-r..=r).map(move |dx| (dx, dy)))
+            .step_by(step)
+            .flat_map(|dy| (-r..=r).step_by(step).map(move |dx| (dx, dy)))
             .filter_map(|(dx, dy)| {
                 let q = (p.0.checked_add_signed(dx)?, p.1.checked_add_signed(dy)?);
                 Some((dx as f64, dy as f64, (*self.values.get(*self.at.get(&q)?)?)?))
@@ -182,7 +186,7 @@ mod tests {
     fn patches(d: impl Fn(f64, f64) -> f64) -> PatchDisparities {
         let points: Vec<(usize, usize)> = (0..20).flat_map(|j| (0..20).map(move |i| (10 + 2 * i, 10 + 2 * j))).collect();
         let values: Vec<Option<f64>> = points.iter().map(|&(x, y)| Some(d(x as f64, y as f64))).collect();
-        PatchDisparities::new(&points, &values)
+        PatchDisparities::new(&points, values, 2)
     }
 
     #[test]
@@ -203,7 +207,8 @@ mod tests {
         // Neighbours on one row only do not fix the vertical gradient.
         let row = PatchDisparities::new(
             &[(8, 20), (10, 20), (12, 20), (14, 20), (16, 20), (6, 20), (4, 20), (18, 20), (20, 20)],
-            &[Some(0.1); 9],
+            vec![Some(0.1); 9],
+            2,
         );
         assert!(row.slope_at((12, 20), 4).is_none());
     }
