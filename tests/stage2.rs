@@ -11,12 +11,17 @@ use std::path::Path;
 /// A 64x64 version of `configs/scenes/objects.toml` turning at 1 rad/s about Y (about 2.7 px of
 /// rolling-shutter shift at the image edges).
 fn generate(dir: &Path) {
+    generate_turning(dir, 1.0);
+}
+
+/// The same scene turning at `omega_y` rad/s about Y.
+fn generate_turning(dir: &Path, omega_y: f64) {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml")).unwrap();
     let text = text.replace("size = [512, 512]", "size = [64, 64]").replace("supersampling = 2", "supersampling = 1");
     let description = dir.join("moving.toml");
     std::fs::write(
         &description,
-        format!("{text}\n[motion]\nmodel = \"constant_velocity\"\nomega_rad_s = [0.0, 1.0, 0.0]\nvelocity_m_s = [0.0, 0.0, 0.0]\n"),
+        format!("{text}\n[motion]\nmodel = \"constant_velocity\"\nomega_rad_s = [0.0, {omega_y:?}, 0.0]\nvelocity_m_s = [0.0, 0.0, 0.0]\n"),
     )
     .unwrap();
     let (ok, _, stderr) = rslf(&["generate", description.to_str().unwrap(), "--out", dir.join("scene").to_str().unwrap()]);
@@ -144,4 +149,46 @@ fn aperture_weighting_reaches_the_motion_only_the_joint_refinement_sees_every_pi
     let (_, free) = run("free", "");
     let (_, free_weighted) = run("free_weighted", "aperture_weighting = true");
     assert_ne!(format!("{free:?}"), format!("{free_weighted:?}"), "the weights did not reach the motion");
+}
+
+#[test]
+fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
+    // Measured on these scenes: the photometric fit of the turning scene has a support of 0.92
+    // (± 0.06), that of the still one 0.28 (± 0.13); at 0.8 the first is kept, the second refuted.
+    let lines = |stdout: &str, start: &str| stdout.lines().filter(|l| l.starts_with(start)).map(str::to_string).collect::<Vec<_>>();
+    let extra = "iterations = 10\ncue_weight = 1.0\nmin_cue_support = 0.8";
+    for (omega, kept) in [(1.0, true), (0.0, false)] {
+        let root = common::tempdir();
+        generate_turning(root.path(), omega);
+        let stdout = train(root.path(), &config(root.path(), "checked", "constant_velocity", extra), "checked");
+        // The fit the check judges leaves the measured cues out.
+        let first = lines(&stdout, "stage 2 fit: ");
+        assert!(first.len() == 1 && !first[0].contains("measured-cue term"), "{stdout}");
+        let check = lines(&stdout, "stage 2 check: ");
+        assert!(check.len() == 1 && check[0].ends_with(if kept { "kept" } else { "no motion kept" }), "{stdout}");
+        let second = lines(&stdout, "stage 2 fit with the measured cues: ");
+        let out = root.path().join("checked");
+        let motion = MotionRecord::read(&out.join("motion.toml")).unwrap();
+        let still = motion == MotionRecord::ConstantVelocity { omega_rad_s: [0.0; 3], velocity_m_s: [0.0; 3] };
+        if kept {
+            assert!(second.len() == 1 && second[0].contains("measured-cue term ×1 over"), "{stdout}");
+            let curve = std::fs::read_to_string(out.join("loss_stage2_cues.csv")).unwrap();
+            assert_eq!(curve.lines().count(), 11, "{curve}");
+            assert!(!still, "{motion:?}");
+        } else {
+            assert!(second.is_empty() && !out.join("loss_stage2_cues.csv").exists(), "{stdout}");
+            assert!(still, "{motion:?}");
+        }
+    }
+    // With no check, the one fit has the term from its first step.
+    let root = common::tempdir();
+    generate(root.path());
+    let stdout = train(
+        root.path(),
+        &config(root.path(), "unchecked", "constant_velocity", "iterations = 10\ncue_weight = 1.0\nmin_cue_support = 0.0"),
+        "unchecked",
+    );
+    let fits = lines(&stdout, "stage 2 fit");
+    assert!(fits.len() == 1 && fits[0].contains("measured-cue term ×1 over"), "{stdout}");
+    assert!(!stdout.contains("stage 2 check"), "{stdout}");
 }

@@ -194,7 +194,8 @@ pub struct Stage2Config {
     /// each corner's column are tracked into the central view (their disparity) and into the
     /// corner, which measures, with no scene model, how far the motion moved each from where its
     /// disparity alone puts it; the term is the mean Huber penalty (px) of the motion's
-    /// predicted cues against those.
+    /// predicted cues against those. With the cue check on, the term is left out of the fit the
+    /// check judges, and a kept motion is fitted again from the start with it.
     pub cue_weight: f64,
     /// The least support (0..1) the cues measured between the views must give the estimated
     /// motion for it to be kept: the noise-weighted least-squares scale of the estimate's
@@ -223,7 +224,7 @@ impl Default for Stage2Config {
             mask_disocclusions: false,
             disocclusion_margin: 2,
             aperture_weighting: false,
-            cue_weight: 0.0,
+            cue_weight: 1.0,
             min_cue_support: 0.5,
             initial_motion: None,
         }
