@@ -137,7 +137,7 @@ fn a_still_capture_refutes_a_pan_and_a_generated_pan_bears_out_its_own_motion() 
     let (of_pan, of_drift) = (support(&pan), support(&drift));
     eprintln!("dino, {} cues: support of a pan {of_pan:?}, of a drift {of_drift:?}", cues.len());
     // The views show no pan, and the check refutes one.
-    assert!(of_pan.share.abs() < 0.15 && of_pan.refutes(0.5), "{of_pan:?}");
+    assert!(of_pan.share.abs() < 0.15 && of_pan.refutes(0.5) && !of_pan.confirms(0.5), "{of_pan:?}");
     // Dino's disparities are small, so a roll-and-zoom drift of this size moves its cues by
     // about 0.01 px: too little to judge, and the check keeps what it cannot refute.
     assert!(of_drift.standard_error > 0.1 && !of_drift.refutes(0.5), "{of_drift:?}");
@@ -150,6 +150,6 @@ fn a_still_capture_refutes_a_pan_and_a_generated_pan_bears_out_its_own_motion() 
     let half = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.6, 0.0], velocity_m_s: [0.0, 0.0, 0.0] };
     let double = cue_support(&camera, &half, &cues).unwrap();
     eprintln!("generated pan: support of the truth {:.3}, of twice the truth {:.3}", full.share, double.share);
-    assert!((full.share - 1.0).abs() < 0.15, "{full:?}");
+    assert!((full.share - 1.0).abs() < 0.15 && full.confirms(0.5) && !full.refutes(0.5), "{full:?}");
     assert!((double.share - 0.5).abs() < 0.1, "{double:?}");
 }

@@ -36,6 +36,12 @@ impl CueSupport {
     pub fn refutes(&self, min_share: f64) -> bool {
         self.share + 2.0 * self.standard_error < min_share
     }
+
+    /// Whether the cues confirm a motion at the threshold `min_share`: its support lies at or
+    /// over it by at least two standard errors.
+    pub fn confirms(&self, min_share: f64) -> bool {
+        self.share - 2.0 * self.standard_error >= min_share
+    }
 }
 
 /// The support `cues` give `estimate` on a scene seen by `camera`: each component of each cue
