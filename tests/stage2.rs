@@ -155,54 +155,47 @@ fn aperture_weighting_reaches_the_motion_only_the_joint_refinement_sees_every_pi
 fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
     // Measured on these scenes: the photometric fit of the turning scene has a support of 0.92
     // (± 0.06), that of the still one 0.28 (± 0.13); at 0.7 the cues confirm the first (0.80
-    // after two standard errors) and refute the second (0.54).
+    // after two standard errors) and refute the second (0.54); at 0.45 the second is neither.
+    let (turning, still) = (common::tempdir(), common::tempdir());
+    generate_turning(turning.path(), 1.0);
+    generate_turning(still.path(), 0.0);
+    let none = MotionRecord::ConstantVelocity { omega_rad_s: [0.0; 3], velocity_m_s: [0.0; 3] };
     let lines = |stdout: &str, start: &str| stdout.lines().filter(|l| l.starts_with(start)).map(str::to_string).collect::<Vec<_>>();
-    let extra = "iterations = 10\ncue_weight = 1.0\nmin_cue_support = 0.7";
-    for (omega, kept) in [(1.0, true), (0.0, false)] {
-        let root = common::tempdir();
-        generate_turning(root.path(), omega);
-        let stdout = train(root.path(), &config(root.path(), "checked", "constant_velocity", extra), "checked");
+    // Trains `name` on the scene in `root` with the cue term and the check at `min_support`;
+    // returns the log, the result folder and its motion.
+    let run = |root: &Path, name: &str, min_support: f64| {
+        let extra = format!("iterations = 10\ncue_weight = 1.0\nmin_cue_support = {min_support:?}");
+        let stdout = train(root, &config(root, name, "constant_velocity", &extra), name);
+        let out = root.join(name);
+        let motion = MotionRecord::read(&out.join("motion.toml")).unwrap();
+        (stdout, out, motion)
+    };
+    for (root, kept) in [(turning.path(), true), (still.path(), false)] {
+        let (stdout, out, motion) = run(root, "checked", 0.7);
         // The fit the check judges leaves the measured cues out.
         let first = lines(&stdout, "stage 2 fit: ");
         assert!(first.len() == 1 && !first[0].contains("measured-cue term"), "{stdout}");
         let check = lines(&stdout, "stage 2 check: ");
         assert!(check.len() == 1 && check[0].ends_with(if kept { "clearly over 0.7: kept" } else { "no motion kept" }), "{stdout}");
         let second = lines(&stdout, "stage 2 fit with the measured cues: ");
-        let out = root.path().join("checked");
-        let motion = MotionRecord::read(&out.join("motion.toml")).unwrap();
-        let still = motion == MotionRecord::ConstantVelocity { omega_rad_s: [0.0; 3], velocity_m_s: [0.0; 3] };
         if kept {
             assert!(second.len() == 1 && second[0].contains("measured-cue term ×1 over"), "{stdout}");
             let curve = std::fs::read_to_string(out.join("loss_stage2_cues.csv")).unwrap();
             assert_eq!(curve.lines().count(), 11, "{curve}");
-            assert!(!still, "{motion:?}");
+            assert!(motion != none, "{motion:?}");
         } else {
             assert!(second.is_empty() && !out.join("loss_stage2_cues.csv").exists(), "{stdout}");
-            assert!(still, "{motion:?}");
+            assert!(motion == none, "{motion:?}");
         }
     }
-    // At 0.45 the still scene's photometric fit is neither refuted (0.54) nor confirmed: it is
-    // kept as fitted, and the term does not run.
-    let root = common::tempdir();
-    generate_turning(root.path(), 0.0);
-    let stdout = train(
-        root.path(),
-        &config(root.path(), "undecided", "constant_velocity", "iterations = 10\ncue_weight = 1.0\nmin_cue_support = 0.45"),
-        "undecided",
-    );
+    // Neither refuted nor confirmed: kept as fitted, and the term does not run.
+    let (stdout, _, motion) = run(still.path(), "undecided", 0.45);
     let check = lines(&stdout, "stage 2 check: ");
     assert!(check.len() == 1 && check[0].ends_with("kept as fitted"), "{stdout}");
     assert!(lines(&stdout, "stage 2 fit with the measured cues").is_empty(), "{stdout}");
-    let motion = MotionRecord::read(&root.path().join("undecided/motion.toml")).unwrap();
-    assert_ne!(motion, MotionRecord::ConstantVelocity { omega_rad_s: [0.0; 3], velocity_m_s: [0.0; 3] });
+    assert_ne!(motion, none);
     // With no check, the one fit has the term from its first step.
-    let root = common::tempdir();
-    generate(root.path());
-    let stdout = train(
-        root.path(),
-        &config(root.path(), "unchecked", "constant_velocity", "iterations = 10\ncue_weight = 1.0\nmin_cue_support = 0.0"),
-        "unchecked",
-    );
+    let (stdout, _, _) = run(turning.path(), "unchecked", 0.0);
     let fits = lines(&stdout, "stage 2 fit");
     assert!(fits.len() == 1 && fits[0].contains("measured-cue term ×1 over"), "{stdout}");
     assert!(!stdout.contains("stage 2 check"), "{stdout}");
