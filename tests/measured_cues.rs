@@ -1,6 +1,6 @@
-//! Rolling-shutter cues measured from the views alone: zero on a real still light field (HCI
-//! antinous, whose views are synchronised and whose vertical and horizontal baselines are
-//! equal), the true motion's on a generated moving one, and the stage-2 cue term (a burn tensor
+//! Rolling-shutter cues measured from the views alone: zero in every off-row view of a real
+//! still light field (HCI antinous, whose views are synchronised and whose vertical and
+//! horizontal baselines are equal), the true motion's on a generated moving one, and the stage-2 cue term (a burn tensor
 //! program) agrees with the host prediction it is built from.
 
 mod common;
@@ -8,10 +8,12 @@ mod common;
 use burn::tensor::{Device, Tensor, TensorData};
 use common::{hci, tempdir};
 use rslf::config::MotionConfig;
+use rslf::config::ViewSelection;
+use rslf::geometry::ViewId;
 use rslf::geometry::{TensorCamera, readout_interval};
 use rslf::io::{GroundTruth, MotionRecord, Scene, read_pfm};
 use rslf::model::motion::{MotionRegistry, MotionSetup};
-use rslf::pipeline::{Cue, CueTerm, cue_support, measure_cues, plane_sweep, predicted_cue, sweep_settings};
+use rslf::pipeline::{Cue, CueTerm, cue_support, measure_cues, plane_sweep, predicted_cue, stage2_views, sweep_settings};
 use rslf::synth::{GenerateOptions, base_scene, generate};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -20,17 +22,32 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 #[test]
-fn antinous_corners_sit_where_the_central_row_disparity_puts_them() {
+fn antinous_off_row_views_sit_where_the_central_row_disparity_puts_them() {
     let dir = hci("antinous");
     let scene = Scene::load(&dir).unwrap();
     let guess = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
-    let cues = measure_cues(&scene, &guess);
+    let views = stage2_views(&scene, ViewSelection::AllOffRow);
+    let cues = measure_cues(&scene, &guess, &views);
     let (mx, my) = (median(cues.iter().map(|c| c.offset.0.abs()).collect()), median(cues.iter().map(|c| c.offset.1.abs()).collect()));
     let (sx, sy) = (median(cues.iter().map(|c| c.offset.0).collect()), median(cues.iter().map(|c| c.offset.1).collect()));
     eprintln!("{} cues; median |offset| {mx:.4} / {my:.4} px, median offset {sx:.4} / {sy:.4} px", cues.len());
-    assert!(cues.len() > 2000, "{} cues", cues.len());
-    // Tracking noise of about 0.08 px (8-bit views at 512 px), centred on zero both ways: the
-    // corners show no motion and their vertical parallax is the row's horizontal one.
+    // Every view off the central row and the central column gets its cues.
+    let centre = scene.central_id();
+    let expected: Vec<ViewId> = views.iter().copied().filter(|v| v.col != centre.col).collect();
+    assert_eq!(expected.len(), 64);
+    for view in &expected {
+        let mine: Vec<&Cue> = cues.iter().filter(|c| c.view == *view).collect();
+        assert!(mine.len() > 500, "{} cues in {view:?}", mine.len());
+        // A view `b` rows and `a` columns off the centre, with no motion, sits where the row's
+        // parallax puts it: the vertical baseline is the horizontal one, and rows count down (a
+        // sign or order slip would put it pixels off). Measured: within 0.02 px horizontally;
+        // vertically within 0.01 px plus the disparity's own bias (about 0.018 px / |a|, tracked
+        // over `a` views) `b` times over: up to 0.078 px in rows 0 and 8 of columns 3 and 5.
+        let (vx, vy) = (median(mine.iter().map(|c| c.offset.0).collect()), median(mine.iter().map(|c| c.offset.1).collect()));
+        let (a, b) = (view.col.abs_diff(centre.col) as f64, view.row.abs_diff(centre.row) as f64);
+        assert!(vx.abs() < 0.025 && vy.abs() < 0.01 + 0.02 * b / a, "{view:?}: median offset {vx} / {vy}");
+    }
+    // Tracking noise of about 0.08 px (8-bit views at 512 px), centred on zero both ways.
     assert!(mx < 0.15 && my < 0.15, "median |offset| {mx} / {my}");
     assert!(sx.abs() < 0.01 && sy.abs() < 0.01, "median offset {sx} / {sy}");
     // Each cue's disparity is the truth's where the patch lies (HCI's disparity sign).
@@ -57,7 +74,7 @@ fn a_pan_shows_in_the_measured_cues_as_its_motion_predicts_them() {
     let (_dir, scene) = moving_objects(&truth);
     let camera = scene.camera().unwrap();
     let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
-    let cues = measure_cues(&scene, gt.disparity.as_ref().unwrap());
+    let cues = measure_cues(&scene, gt.disparity.as_ref().unwrap(), &scene.grid.corners());
     assert!(cues.len() > 2000, "{} cues", cues.len());
     // A cue offset (px), and (measured, predicted) per cue.
     type Offset = (f64, f64);
@@ -129,7 +146,7 @@ fn a_still_capture_refutes_a_pan_and_a_generated_pan_bears_out_its_own_motion() 
     let camera = rslf::geometry::Camera { line_time_s: 5e-5, ..scene.camera().unwrap() };
     let config = rslf::config::Config::default();
     let guess = plane_sweep(&scene, &scene.central_row_views(), &sweep_settings(&config, &scene), |_, _| {}).disparity;
-    let cues = measure_cues(&scene, &guess);
+    let cues = measure_cues(&scene, &guess, &scene.grid.corners());
     // The drift the photometric fit settles in on still suite scenes (roll and zoom), and a pan.
     let drift = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.0, 0.2], velocity_m_s: [0.0, 0.0, -0.4] };
     let pan = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.3, 0.0], velocity_m_s: [0.0, 0.0, 0.0] };
@@ -145,7 +162,7 @@ fn a_still_capture_refutes_a_pan_and_a_generated_pan_bears_out_its_own_motion() 
     let (_dir, moving) = moving_objects(&pan);
     let camera = moving.camera().unwrap();
     let guess = plane_sweep(&moving, &moving.central_row_views(), &sweep_settings(&config, &moving), |_, _| {}).disparity;
-    let cues = measure_cues(&moving, &guess);
+    let cues = measure_cues(&moving, &guess, &moving.grid.corners());
     let full = cue_support(&camera, &pan, &cues).unwrap();
     let half = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.6, 0.0], velocity_m_s: [0.0, 0.0, 0.0] };
     let double = cue_support(&camera, &half, &cues).unwrap();

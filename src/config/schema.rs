@@ -191,8 +191,8 @@ pub struct Stage2Config {
     /// bend the motion. Under joint refinement the Gaussians still compare every pixel.
     pub aperture_weighting: bool,
     /// Weight of the measured-cue term (0 = off): textured patches of the central-row view of
-    /// each corner's column are tracked into the central view (their disparity) and into the
-    /// corner, which measures, with no scene model, how far the motion moved each from where its
+    /// the column of each view in `cue_views` are tracked into the central view (their
+    /// disparity) and into that view, which measures, with no scene model, how far the motion moved each from where its
     /// disparity alone puts it; the term is the mean Huber penalty (px) of the motion's
     /// predicted cues against those. With the cue check on, the term is left out of the fit the
     /// check judges, and a motion the check confirms is fitted again from the start with it.
@@ -203,6 +203,10 @@ pub struct Stage2Config {
     /// it by more than two standard errors, the estimate is taken for a drift of the photometric
     /// fit and no motion is kept. 0 = no check.
     pub min_cue_support: f64,
+    /// The views the cues are measured in: `corners` or `all_off_row` (every present view off
+    /// the central row and the central column, each tracked from the central-row view of its
+    /// column).
+    pub cue_views: ViewSelection,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
     pub initial_motion: Option<PathBuf>,
@@ -226,6 +230,7 @@ impl Default for Stage2Config {
             aperture_weighting: false,
             cue_weight: 1.0,
             min_cue_support: 0.5,
+            cue_views: ViewSelection::Corners,
             initial_motion: None,
         }
     }

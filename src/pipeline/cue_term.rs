@@ -3,7 +3,7 @@
 //!
 //! Each cue's point (its central-view position and measured disparity, the scene at its row's
 //! read-out time) is moved back to t = 0 under the motion and re-imaged, each at its own row's
-//! time, into its corner view: the same tensor program that places the Gaussians, so the
+//! time, into its off-row view: the same tensor program that places the Gaussians, so the
 //! gradient with respect to the motion comes from the framework. The term is the mean Huber
 //! penalty of the difference, in pixels.
 
@@ -16,8 +16,8 @@ use burn::module::Module;
 use burn::nn::loss::{HuberLoss, HuberLossConfig};
 use burn::tensor::{Device, Tensor, TensorData};
 
-/// The measured cues of one corner view, as tensors.
-struct CornerCues {
+/// The measured cues of one off-row view, as tensors.
+struct ViewCues {
     /// The cue points as zero-size Gaussians of the central view (no gradient).
     points: crate::model::Gaussians,
     /// The view offset `(c - cc, r - rc)`.
@@ -29,7 +29,7 @@ struct CornerCues {
 
 /// The measured-cue term of stage 2.
 pub struct CueTerm {
-    corners: Vec<CornerCues>,
+    views: Vec<ViewCues>,
     /// Its weight in the objective.
     pub weight: f32,
     /// The penalty: quadratic within its threshold (px), linear beyond.
@@ -46,7 +46,7 @@ impl CueTerm {
         let mut views: Vec<_> = cues.iter().map(|c| c.view).collect();
         views.sort();
         views.dedup();
-        let corners = views
+        let per_view = views
             .into_iter()
             .map(|view| {
                 let mine: Vec<&Cue> = cues.iter().filter(|c| c.view == view).collect();
@@ -69,26 +69,21 @@ impl CueTerm {
                     Tensor::<1>::from_data(TensorData::new(data, [n]), device)
                 };
                 let (a, b) = camera.grid.offset(view);
-                CornerCues {
-                    points: set.to_module(device).no_grad(),
-                    offset: (a as f32, b as f32),
-                    target_u: target(0),
-                    target_v: target(1),
-                }
+                ViewCues { points: set.to_module(device).no_grad(), offset: (a as f32, b as f32), target_u: target(0), target_v: target(1) }
             })
             .collect();
-        Self { corners, weight, huber: HuberLossConfig::new(huber_px).init(), timing_iterations, len: cues.len() }
+        Self { views: per_view, weight, huber: HuberLossConfig::new(huber_px).init(), timing_iterations, len: cues.len() }
     }
 
     /// The weighted mean Huber penalty of the cues predicted by `model` at `params` (SI) against
     /// the measured ones: a one-element tensor.
     pub fn evaluate(&self, camera: TensorCamera, model: &dyn MotionModel, params: Tensor<1>) -> Tensor<1> {
         let mut total: Option<Tensor<1>> = None;
-        for corner in &self.corners {
-            let shape = StaticShape::new(&corner.points, camera, model, params.clone());
-            let splats = shape.splats_rolling(model, params.clone(), corner.offset, self.timing_iterations);
-            let sum = self.huber.forward_no_reduction(splats.u, corner.target_u.clone()).sum()
-                + self.huber.forward_no_reduction(splats.v, corner.target_v.clone()).sum();
+        for view in &self.views {
+            let shape = StaticShape::new(&view.points, camera, model, params.clone());
+            let splats = shape.splats_rolling(model, params.clone(), view.offset, self.timing_iterations);
+            let sum = self.huber.forward_no_reduction(splats.u, view.target_u.clone()).sum()
+                + self.huber.forward_no_reduction(splats.v, view.target_v.clone()).sum();
             total = Some(match total {
                 Some(t) => t + sum,
                 None => sum,

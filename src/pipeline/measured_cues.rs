@@ -1,11 +1,11 @@
 //! Rolling-shutter cues measured straight from the views, with no scene model.
 //!
 //! The views of the central row read each image row at the same time, so a patch moves between
-//! them by its disparity alone: `a d` between views `a` columns apart. A corner view `(r, c)`
-//! sees the same patch `b = r - rc` view rows away, `b d` image rows up or down, read that much
+//! them by its disparity alone: `a d` between views `a` columns apart. A view `(r, c)` off the
+//! central row sees the same patch `b = r - rc` view rows away, `b d` image rows up or down, read that much
 //! earlier or later; under a motion it sits `μ` off where the disparity alone puts it. Tracking a
-//! textured patch of the central-row view of the corner's column into the central view (which
-//! gives `d`) and into the corner (same column: no horizontal parallax) measures `μ`:
+//! textured patch of the central-row view of that view's column into the central view (which
+//! gives `d`) and into the view (same column: no horizontal parallax) measures `μ`:
 //! [`measure_cues`]. With a still camera every `μ` is zero up to the tracking noise.
 //!
 //! Stage 2 can weigh these against the cues its motion predicts ([`super::cue_term`]); the
@@ -20,51 +20,55 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
-/// it sits in one corner view against where its disparity alone would put it.
+/// it sits in one off-row view against where its disparity alone would put it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cue {
     /// The patch centre in the central view (px).
     pub at: (f64, f64),
-    /// Its disparity, measured against the central-row view of the corner's column (px).
+    /// Its disparity, measured against the central-row view of the view's column (px).
     pub disparity: f64,
-    /// The corner view.
+    /// The off-row view.
     pub view: ViewId,
     /// Its offset in that view from the position its disparity gives (px).
     pub offset: (f64, f64),
 }
 
-/// The measured cues of `scene`, corner by corner: the patches of the central-row view of the
-/// corner's column that are textured in both directions (on a grid of about 128 x 128), each
-/// tracked into the central view and into the corner. `guess` (a disparity map of the central
-/// view, e.g. the plane sweep's) only starts the tracking. Patches lost in either view, or found
-/// more than 0.25 px up or down in the central view (the row views are read at the same time,
-/// so that is a mismatch), are left out. Corners or row views the scene lacks give no cues.
+/// The measured cues of `scene` in `views` (e.g. the four corners), column by column: the patches
+/// of the central-row view of a view's column that are textured in both directions (on a grid of
+/// about 128 x 128), each tracked into the central view and into the view. `guess` (a disparity
+/// map of the central view, e.g. the plane sweep's) only starts the tracking. Patches lost in
+/// either view, or found more than 0.25 px up or down in the central view (the row views are
+/// read at the same time, so that is a mismatch), are left out. Views of the central row (no
+/// vertical offset, no cue) or of the central column (no horizontal baseline to measure the
+/// disparity against), views the scene lacks, and columns whose central-row view it lacks give
+/// no cues.
 ///
 /// A patch on a surface slanted in depth is sheared between row views and stretched between
-/// a row view and a corner by its disparity gradient, and a translation-only match of a
+/// a row view and an off-row view by its disparity gradient, and a translation-only match of a
 /// deformed patch lands where its gradient energy is centred, which differs between the
 /// horizontal match that gives `d` and the vertical one that gives `μ`: on a receding floor that
 /// biases every `μ` the same way. So the tracking is done twice: a first pass gives each patch's
 /// disparity, a plane fitted to its neighbours' gives the local gradient, and the second pass
 /// matches with the deformation that gradient predicts ([`track_warped`]). Patches whose
 /// neighbours fit no plane (a depth edge, a bad match) are left out too.
-pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
+pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue> {
     let grid = scene.grid;
     let (Some(centre), w, h) = (grid.central(), scene.width(), scene.height()) else { return Vec::new() };
     let settings = TrackSettings::default();
     let central = scene.central().to_grey();
     let stride = ((w * h) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
     let mut cues = Vec::new();
-    // The corners two by two, by column: both are tracked from the same row view.
-    let mut columns: Vec<usize> = grid.corners().iter().map(|c| c.col).collect();
+    // The views column by column: those of a column are tracked from the same row view.
+    let views: Vec<ViewId> = views.iter().copied().filter(|v| v.row != centre.row && v.col != centre.col).collect();
+    let mut columns: Vec<usize> = views.iter().map(|v| v.col).collect();
     columns.sort();
     columns.dedup();
     for col in columns {
-        let corners: Vec<(ViewId, Raster)> =
-            grid.corners().into_iter().filter(|c| c.col == col).filter_map(|c| Some((c, scene.view(c)?.to_grey()))).collect();
+        let targets: Vec<(ViewId, Raster)> =
+            views.iter().filter(|v| v.col == col).filter_map(|&v| Some((v, scene.view(v)?.to_grey()))).collect();
         let Some(row_img) = scene.view(ViewId { row: centre.row, col }) else { continue };
         let a = grid.offset(ViewId { row: centre.row, col }).0;
-        if a == 0.0 || corners.is_empty() {
+        if a == 0.0 || targets.is_empty() {
             continue;
         }
         let row_img = row_img.to_grey();
@@ -91,14 +95,14 @@ pub fn measure_cues(scene: &Scene, guess: &Raster) -> Vec<Cue> {
             .filter_map(|(&(x, y), &d1)| {
                 let slope = first.slope_at((x, y), reach)?;
                 let d = to_centre((x, y), d1?, slope)?;
-                // The same patch in each corner of its column: `b d` rows up or down, and `μ`.
-                let in_corners = corners.iter().filter_map(|(view, image)| {
+                // The same patch in each view of its column: `b d` rows up or down, and `μ`.
+                let in_views = targets.iter().filter_map(|(view, image)| {
                     let b = grid.offset(*view).1;
                     let linear = [[0.0, 0.0], [-b * slope.0, -b * slope.1]];
                     let (dx, dy) = track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, &settings)?.displacement;
                     Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d) })
                 });
-                Some(in_corners.collect())
+                Some(in_views.collect())
             })
             .collect();
         cues.extend(found.into_iter().flatten());

@@ -364,10 +364,16 @@ fn stage2(
     let check = s.min_cue_support > 0.0 && s.iterations > 0;
     let cues = (s.cue_weight > 0.0 || check).then(|| {
         let start = Instant::now();
-        let cues = measure_cues(scene, initial_disparity);
+        let cue_views = stage2_views(scene, s.cue_views);
+        let cues = measure_cues(scene, initial_disparity, &cue_views);
+        let mut measured_in: Vec<ViewId> = cues.iter().map(|c| c.view).collect();
+        measured_in.sort();
+        measured_in.dedup();
         log.lines.push(format!(
-            "stage 2 cues: {} measured, textured patches of the central-row views of the corners' columns tracked into the central view and the corners, {:.1} s",
+            "stage 2 cues: {} measured in {} views off the central row and column ({:?}), textured patches of the central-row view of each one's column tracked into the central view and into it, {:.1} s",
             cues.len(),
+            measured_in.len(),
+            s.cue_views,
             start.elapsed().as_secs_f64()
         ));
         cues
