@@ -1,16 +1,14 @@
 //! Rolling-shutter cues measured from the views alone: zero in every off-row view of a real
 //! still light field (HCI antinous, whose views are synchronised and whose vertical and
-//! horizontal baselines are equal), the true motion's on a generated moving one, and the stage-2 cue term (a burn tensor
-//! program) agrees with the host prediction it is built from.
+//! horizontal baselines are equal), the true motion's on a generated moving one, and the
+//! stage-2 cue term (a burn tensor program) agrees with the host prediction it is built from.
 
 mod common;
 
 use burn::tensor::{Device, Tensor, TensorData};
 use common::{hci, tempdir};
-use rslf::config::MotionConfig;
-use rslf::config::ViewSelection;
-use rslf::geometry::ViewId;
-use rslf::geometry::{TensorCamera, readout_interval};
+use rslf::config::{MotionConfig, ViewSelection};
+use rslf::geometry::{TensorCamera, ViewId, readout_interval};
 use rslf::io::{GroundTruth, MotionRecord, Scene, read_pfm};
 use rslf::model::motion::{MotionRegistry, MotionSetup};
 use rslf::pipeline::{Cue, CueTerm, cue_support, measure_cues, plane_sweep, predicted_cue, stage2_views, sweep_settings};

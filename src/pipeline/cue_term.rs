@@ -43,14 +43,13 @@ pub struct CueTerm {
 impl CueTerm {
     /// The term for `cues` of a scene seen by `camera`, on `device`.
     pub fn new(cues: &[Cue], camera: &Camera, weight: f32, huber_px: f32, timing_iterations: usize, device: &Device) -> Self {
-        let mut views: Vec<_> = cues.iter().map(|c| c.view).collect();
-        views.sort();
-        views.dedup();
-        let per_view = views
-            .into_iter()
-            .map(|view| {
-                let mine: Vec<&Cue> = cues.iter().filter(|c| c.view == view).collect();
-                let n = mine.len();
+        // The cues grouped by view in one sort (stable: each view's cues keep their order).
+        let mut sorted: Vec<&Cue> = cues.iter().collect();
+        sorted.sort_by_key(|c| c.view);
+        let per_view = sorted
+            .chunk_by(|x, y| x.view == y.view)
+            .map(|mine| {
+                let (view, n) = (mine[0].view, mine.len());
                 let set = GaussianSet {
                     u: mine.iter().map(|c| c.at.0 as f32).collect(),
                     v: mine.iter().map(|c| c.at.1 as f32).collect(),

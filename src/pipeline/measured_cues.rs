@@ -2,11 +2,11 @@
 //!
 //! The views of the central row read each image row at the same time, so a patch moves between
 //! them by its disparity alone: `a d` between views `a` columns apart. A view `(r, c)` off the
-//! central row sees the same patch `b = r - rc` view rows away, `b d` image rows up or down, read that much
-//! earlier or later; under a motion it sits `μ` off where the disparity alone puts it. Tracking a
-//! textured patch of the central-row view of that view's column into the central view (which
-//! gives `d`) and into the view (same column: no horizontal parallax) measures `μ`:
-//! [`measure_cues`]. With a still camera every `μ` is zero up to the tracking noise.
+//! central row sees the same patch `b = r - rc` view rows away, `b d` image rows up or down,
+//! read that much earlier or later; under a motion it sits `μ` off where the disparity alone
+//! puts it. Tracking a textured patch of the central-row view of that view's column into the
+//! central view (which gives `d`) and into the view (same column: no horizontal parallax)
+//! measures `μ`: [`measure_cues`]. With a still camera every `μ` is zero up to the tracking noise.
 //!
 //! Stage 2 can weigh these against the cues its motion predicts ([`super::cue_term`]); the
 //! photometric fit alone compares the corners with renders of the stage-1 model, whose errors

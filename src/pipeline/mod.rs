@@ -366,9 +366,7 @@ fn stage2(
         let start = Instant::now();
         let cue_views = stage2_views(scene, s.cue_views);
         let cues = measure_cues(scene, initial_disparity, &cue_views);
-        let mut measured_in: Vec<ViewId> = cues.iter().map(|c| c.view).collect();
-        measured_in.sort();
-        measured_in.dedup();
+        let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
         log.lines.push(format!(
             "stage 2 cues: {} measured in {} views off the central row and column ({:?}), textured patches of the central-row view of each one's column tracked into the central view and into it, {:.1} s",
             cues.len(),
