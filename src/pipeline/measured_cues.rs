@@ -4,9 +4,10 @@
 //! them by its disparity alone: `a d` between views `a` columns apart. A view `(r, c)` off the
 //! central row sees the same patch `b = r - rc` view rows away, `b d` image rows up or down,
 //! read that much earlier or later; under a motion it sits `μ` off where the disparity alone
-//! puts it. Tracking a textured patch of the central-row view of that view's column into the
-//! central view (which gives `d`) and into the view (same column: no horizontal parallax)
-//! measures `μ`: [`measure_cues`]. With a still camera every `μ` is zero up to the tracking noise.
+//! puts it. Tracking a textured patch of the central-row view of that view's column into another
+//! view of the central row (which gives `d`) and into the view (same column: no horizontal
+//! parallax) measures `μ`: [`measure_cues`]. With a still camera every `μ` is zero up to the
+//! tracking noise.
 //!
 //! Stage 2 can weigh these against the cues its motion predicts ([`super::cue_term`]); the
 //! photometric fit alone compares the corners with renders of the stage-1 model, whose errors
@@ -35,13 +36,12 @@ pub struct Cue {
 
 /// The measured cues of `scene` in `views` (e.g. the four corners), column by column: the patches
 /// of the central-row view of a view's column that are textured in both directions (on a grid of
-/// about 128 x 128), each tracked into the central view and into the view. `guess` (a disparity
-/// map of the central view, e.g. the plane sweep's) only starts the tracking. Patches lost in
-/// either view, or found more than 0.25 px up or down in the central view (the row views are
-/// read at the same time, so that is a mismatch), are left out. Views of the central row (no
-/// vertical offset, no cue) or of the central column (no horizontal baseline to measure the
-/// disparity against), views the scene lacks, and columns whose central-row view it lacks give
-/// no cues.
+/// about 128 x 128), each tracked into the view of the central row farthest from it (which gives
+/// its disparity) and into the view. `guess` (a disparity map of the central view, e.g. the plane
+/// sweep's) only starts the tracking. Patches lost in either view, or found more than 0.25 px up
+/// or down in the row view (the row views are read at the same time, so that is a mismatch), are
+/// left out. Views of the central row (no vertical offset, no cue) or of the central column, views
+/// the scene lacks, and columns whose central-row view it lacks give no cues.
 ///
 /// A patch on a surface slanted in depth is sheared between row views and stretched between
 /// a row view and an off-row view by its disparity gradient, and a translation-only match of a
@@ -55,7 +55,6 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
     let grid = scene.grid;
     let (Some(centre), w, h) = (grid.central(), scene.width(), scene.height()) else { return Vec::new() };
     let settings = TrackSettings::default();
-    let central = scene.central().to_grey();
     let stride = ((w * h) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
     let mut cues = Vec::new();
     // The views column by column: those of a column are tracked from the same row view.
@@ -68,22 +67,27 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
             views.iter().filter(|v| v.col == col).filter_map(|&v| Some((v, scene.view(v)?.to_grey()))).collect();
         let Some(row_img) = scene.view(ViewId { row: centre.row, col }) else { continue };
         let a = grid.offset(ViewId { row: centre.row, col }).0;
+        // The disparity is measured against the row view farthest from this one: a match's
+        // own bias (a fixed fraction of a pixel) divides by the baseline, and returns `b` times
+        // over in the vertical cue.
+        let Some((partner, baseline)) = longest_row_baseline(scene, col) else { continue };
         if a == 0.0 || targets.is_empty() {
             continue;
         }
         let row_img = row_img.to_grey();
+        let partner = partner.to_grey();
         let points = textured_points(&row_img, settings.radius, stride, 0.1);
-        // The patch of the row view, found in the central view `a d` to the right: `d`.
-        let to_centre = |(x, y): (usize, usize), start: f64, slope: (f64, f64)| {
-            let linear = [[a * slope.0, a * slope.1], [0.0, 0.0]];
-            let found = track_warped(&row_img, &central, (x, y), (a * start, 0.0), linear, &settings)?.displacement;
-            (found.1.abs() <= 0.25).then_some(found.0 / a)
+        // The patch of the row view, found in the partner view `baseline d` to the right: `d`.
+        let to_partner = |(x, y): (usize, usize), start: f64, slope: (f64, f64)| {
+            let linear = [[baseline * slope.0, baseline * slope.1], [0.0, 0.0]];
+            let found = track_warped(&row_img, &partner, (x, y), (baseline * start, 0.0), linear, &settings)?.displacement;
+            (found.1.abs() <= 0.25).then_some(found.0 / baseline)
         };
         let first: Vec<Option<f64>> = points
             .par_iter()
             .map(|&(x, y)| {
                 let gx = ((x as f64 + a * guess_d0(guess, x, y)?).round().max(0.0) as usize).min(w - 1);
-                to_centre((x, y), guess_d0(guess, gx, y)?, (0.0, 0.0))
+                to_partner((x, y), guess_d0(guess, gx, y)?, (0.0, 0.0))
             })
             .collect();
         let first = PatchDisparities::new(&points, first, stride);
@@ -94,7 +98,7 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
             .zip(&first.values)
             .filter_map(|(&(x, y), &d1)| {
                 let slope = first.slope_at((x, y), reach)?;
-                let d = to_centre((x, y), d1?, slope)?;
+                let d = to_partner((x, y), d1?, slope)?;
                 // The same patch in each view of its column: `b d` rows up or down, and `μ`.
                 let in_views = targets.iter().filter_map(|(view, image)| {
                     let b = grid.offset(*view).1;
@@ -108,6 +112,17 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
         cues.extend(found.into_iter().flatten());
     }
     cues
+}
+
+/// The view of the central row farthest from column `col`'s, and the baseline `B` between them
+/// (views): a patch of disparity `d` in column `col`'s view is `B d` to the right in it.
+fn longest_row_baseline(scene: &Scene, col: usize) -> Option<(&Raster, f64)> {
+    let row = scene.grid.central()?.row;
+    let a = scene.grid.offset(ViewId { row, col }).0;
+    (0..scene.grid.cols)
+        .filter(|&c| c != col)
+        .filter_map(|c| Some((scene.view(ViewId { row, col: c })?, a - scene.grid.offset(ViewId { row, col: c }).0)))
+        .max_by(|p, q| p.1.abs().total_cmp(&q.1.abs()))
 }
 
 /// The first-pass disparities of the patches, looked up by position.

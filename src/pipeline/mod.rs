@@ -368,7 +368,7 @@ fn stage2(
         let cues = measure_cues(scene, initial_disparity, &cue_views);
         let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
         log.lines.push(format!(
-            "stage 2 cues: {} measured in {} views off the central row and column ({:?}), textured patches of the central-row view of each one's column tracked into the central view and into it, {:.1} s",
+            "stage 2 cues: {} measured in {} views off the central row and column ({:?}), textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
             cues.len(),
             measured_in.len(),
             s.cue_views,
