@@ -4,6 +4,32 @@
 use super::camera::Camera;
 use burn::tensor::Tensor;
 
+/// The view, or views, points are imaged into, by offset `(c - cc, r - rc)` in the grid.
+#[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)] // passed by value once a projection; never stored in bulk
+pub enum ViewOffset {
+    /// Every point into the same view.
+    Shared(f32, f32),
+    /// Each point into its own view: the column and row offsets, `[N]` each.
+    PerPoint(Tensor<1>, Tensor<1>),
+}
+
+impl From<(f32, f32)> for ViewOffset {
+    fn from((a, b): (f32, f32)) -> Self {
+        Self::Shared(a, b)
+    }
+}
+
+impl ViewOffset {
+    /// The offsets times the points' disparities `d`: their shifts from the central view.
+    fn times(self, d: Tensor<1>) -> (Tensor<1>, Tensor<1>) {
+        match self {
+            Self::Shared(a, b) => (d.clone() * a, d * b),
+            Self::PerPoint(a, b) => (d.clone() * a, d * b),
+        }
+    }
+}
+
 /// The camera constants the tensor programs need, as f32.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TensorCamera {
@@ -52,15 +78,17 @@ impl TensorCamera {
         Tensor::stack::<2>(vec![x, y, z], 1)
     }
 
-    /// Where points `[N, 3]` appear in the view at `offset = (c - cc, r - rc)`: `(u, v, d)` with
-    /// `u = u0 + f X/Z - (c-cc) d` and `v = v0 + f Y/Z - (r-rc) d` (FORMAT's rule).
-    pub fn project(&self, points: Tensor<2>, offset: (f32, f32)) -> (Tensor<1>, Tensor<1>, Tensor<1>) {
+    /// Where points `[N, 3]` appear in the view at `offset = (c - cc, r - rc)` (one view for all,
+    /// or one per point): `(u, v, d)` with `u = u0 + f X/Z - (c-cc) d` and
+    /// `v = v0 + f Y/Z - (r-rc) d` (FORMAT's rule).
+    pub fn project(&self, points: Tensor<2>, offset: impl Into<ViewOffset>) -> (Tensor<1>, Tensor<1>, Tensor<1>) {
         let n = points.dims()[0];
         let part = |i: usize| points.clone().slice([0..n, i..i + 1]).reshape([n]);
         let (x, y, z) = (part(0), part(1), part(2));
         let d = self.disparity(z.clone());
-        let u = x / z.clone() * self.f_px + self.u0 - d.clone() * offset.0;
-        let v = y / z * self.f_px + self.v0 - d.clone() * offset.1;
+        let (shift_u, shift_v) = offset.into().times(d.clone());
+        let u = x / z.clone() * self.f_px + self.u0 - shift_u;
+        let v = y / z * self.f_px + self.v0 - shift_v;
         (u, v, d)
     }
 

@@ -8,7 +8,7 @@ mod rotation;
 mod rs_projection;
 
 pub use camera::{Camera, ViewGrid, ViewId};
-pub use lift::TensorCamera;
+pub use lift::{TensorCamera, ViewOffset};
 pub use rigid_motion::{Pose, pose_at, readout_interval};
 pub use rotation::{PoseBatch, compose, rotate, rotate_inverse, rotation_matrices};
 pub use rs_projection::rs_project;

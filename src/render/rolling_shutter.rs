@@ -9,7 +9,7 @@
 //!   it lands in that view, found by a short fixed-point iteration.
 
 use super::splat::{RenderOutput, RenderSettings, Splats, splat};
-use crate::geometry::TensorCamera;
+use crate::geometry::{TensorCamera, ViewOffset};
 use crate::model::Gaussians;
 use crate::model::motion::MotionModel;
 use burn::tensor::{Device, Tensor};
@@ -52,9 +52,9 @@ impl StaticShape {
         Self { points: pose.apply_inverse(observed), radius_m: g.log_size.val().exp() * z / camera.f_px, colour: g.colour.val(), camera }
     }
 
-    /// The splats of the view at `offset = (c - cc, r - rc)` with every Gaussian at its own time
-    /// `times` (`[N]`, seconds).
-    pub fn splats_at(&self, model: &dyn MotionModel, params: Tensor<1>, offset: (f32, f32), times: Tensor<1>) -> Splats {
+    /// The splats of the view at `offset = (c - cc, r - rc)` (or each Gaussian's own view) with
+    /// every Gaussian at its own time `times` (`[N]`, seconds).
+    pub fn splats_at(&self, model: &dyn MotionModel, params: Tensor<1>, offset: impl Into<ViewOffset>, times: Tensor<1>) -> Splats {
         let moved = model.poses(params, times).apply(self.points.clone());
         let n = moved.dims()[0];
         let z = moved.clone().slice([0..n, 2..3]).reshape([n]);
@@ -63,7 +63,7 @@ impl StaticShape {
     }
 
     /// The splats of the view at `offset`, all Gaussians at time `tau`.
-    pub fn splats_at_time(&self, model: &dyn MotionModel, params: Tensor<1>, offset: (f32, f32), tau: f32) -> Splats {
+    pub fn splats_at_time(&self, model: &dyn MotionModel, params: Tensor<1>, offset: impl Into<ViewOffset>, tau: f32) -> Splats {
         let n = self.points.dims()[0];
         let times = Tensor::<1>::full([n], tau, &self.points.device());
         self.splats_at(model, params, offset, times)
@@ -71,10 +71,11 @@ impl StaticShape {
 
     /// The splats of the view at `offset`, each Gaussian at the read-out time of the row where
     /// it lands: `y <- v(P(t(y)))`, `iterations` times from the row it has at t = 0.
-    pub fn splats_rolling(&self, model: &dyn MotionModel, params: Tensor<1>, offset: (f32, f32), iterations: usize) -> Splats {
-        let (_, mut row, _) = self.camera.project(self.points.clone(), offset);
+    pub fn splats_rolling(&self, model: &dyn MotionModel, params: Tensor<1>, offset: impl Into<ViewOffset>, iterations: usize) -> Splats {
+        let offset = offset.into();
+        let (_, mut row, _) = self.camera.project(self.points.clone(), offset.clone());
         for _ in 0..iterations {
-            let s = self.splats_at(model, params.clone(), offset, self.camera.row_time(row));
+            let s = self.splats_at(model, params.clone(), offset.clone(), self.camera.row_time(row));
             row = s.v;
         }
         self.splats_at(model, params, offset, self.camera.row_time(row))
