@@ -192,10 +192,11 @@ pub struct Stage2Config {
     pub aperture_weighting: bool,
     /// Weight of the measured-cue term (0 = off): textured patches of the central-row view of
     /// the column of each view in `cue_views` are tracked into the view of the central row
-    /// farthest from it (their disparity) and into that view, which measures, with no scene model, how far the motion
-    /// moved each from where its disparity alone puts it; the term is the mean Huber penalty
-    /// (px) of the motion's predicted cues against those. With the cue check on, the term is left out of the fit the
-    /// check judges, and a motion the check confirms is fitted again from the start with it.
+    /// farthest from it (their disparity) and into that view, which measures, with no scene
+    /// model, how far the motion moved each from where its disparity alone puts it; the term is
+    /// the mean Huber penalty (px) of the motion's predicted cues against those. With the cue
+    /// check on, the term is left out of the fit the check judges, and a motion the check
+    /// confirms is fitted again from the start with it.
     pub cue_weight: f64,
     /// The least support (0..1) the cues measured between the views must give the estimated
     /// motion for it to be kept: the noise-weighted least-squares scale of the estimate's

@@ -26,7 +26,8 @@ use std::collections::HashMap;
 pub struct Cue {
     /// The patch centre in the central view (px).
     pub at: (f64, f64),
-    /// Its disparity, measured against the central-row view of the view's column (px).
+    /// Its disparity (px), tracked from the central-row view of the view's column over the
+    /// row's longest baseline.
     pub disparity: f64,
     /// The off-row view.
     pub view: ViewId,
@@ -65,15 +66,12 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
     for col in columns {
         let targets: Vec<(ViewId, Raster)> =
             views.iter().filter(|v| v.col == col).filter_map(|&v| Some((v, scene.view(v)?.to_grey()))).collect();
-        let Some(row_img) = scene.view(ViewId { row: centre.row, col }) else { continue };
+        let Some(row_img) = scene.view(ViewId { row: centre.row, col }).filter(|_| !targets.is_empty()) else { continue };
         let a = grid.offset(ViewId { row: centre.row, col }).0;
         // The disparity is measured against the row view farthest from this one: a match's
         // own bias (a fixed fraction of a pixel) divides by the baseline, and returns `b` times
         // over in the vertical cue.
         let Some((partner, baseline)) = longest_row_baseline(scene, col) else { continue };
-        if a == 0.0 || targets.is_empty() {
-            continue;
-        }
         let row_img = row_img.to_grey();
         let partner = partner.to_grey();
         let points = textured_points(&row_img, settings.radius, stride, 0.1);
