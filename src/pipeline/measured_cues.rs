@@ -115,11 +115,12 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
 /// The view of the central row farthest from column `col`'s, and the baseline `B` between them
 /// (views): a patch of disparity `d` in column `col`'s view is `B d` to the right in it.
 fn longest_row_baseline(scene: &Scene, col: usize) -> Option<(&Raster, f64)> {
-    let row = scene.grid.central()?.row;
-    let a = scene.grid.offset(ViewId { row, col }).0;
-    (0..scene.grid.cols)
-        .filter(|&c| c != col)
-        .filter_map(|c| Some((scene.view(ViewId { row, col: c })?, a - scene.grid.offset(ViewId { row, col: c }).0)))
+    let a = scene.grid.offset(ViewId { row: scene.central_id().row, col }).0;
+    scene
+        .central_row_views()
+        .into_iter()
+        .filter(|v| v.col != col)
+        .filter_map(|v| Some((scene.view(v)?, a - scene.grid.offset(v).0)))
         .max_by(|p, q| p.1.abs().total_cmp(&q.1.abs()))
 }
 
