@@ -160,7 +160,7 @@ fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
     let (turning, still) = (common::tempdir(), common::tempdir());
     generate_turning(turning.path(), 1.0);
     generate_turning(still.path(), 0.0);
-    let none = MotionRecord::ConstantVelocity { omega_rad_s: [0.0; 3], velocity_m_s: [0.0; 3] };
+    let none = MotionRecord::zero();
     let lines = |stdout: &str, start: &str| stdout.lines().filter(|l| l.starts_with(start)).map(str::to_string).collect::<Vec<_>>();
     // Trains `name` on the scene in `root` with the cue term and the check at `min_support`;
     // returns the log, the result folder and its motion.
