@@ -45,8 +45,9 @@ fn antinous_off_row_views_sit_where_the_central_row_disparity_puts_them() {
         let (vx, vy) = (median(mine.iter().map(|c| c.offset.0).collect()), median(mine.iter().map(|c| c.offset.1).collect()));
         assert!(vx.abs() < 0.02 && vy.abs() < 0.02, "{view:?}: median offset {vx} / {vy}");
     }
-    // Tracking noise of about 0.05 px (8-bit views at 512 px), centred on zero both ways.
-    assert!(mx < 0.1 && my < 0.1, "median |offset| {mx} / {my}");
+    // Tracking noise of about 0.04 px (8-bit views at 512 px; 0.053 px when the views were
+    // resampled bilinearly), centred on zero both ways.
+    assert!(mx < 0.07 && my < 0.07, "median |offset| {mx} / {my}");
     assert!(sx.abs() < 0.01 && sy.abs() < 0.01, "median offset {sx} / {sy}");
     // Each cue's disparity is the truth's where the patch lies (HCI's disparity sign).
     let err = median(
@@ -82,12 +83,15 @@ fn a_pan_shows_in_the_measured_cues_as_its_motion_predicts_them() {
     eprintln!("{} cues; median miss {with_truth:.4} px with the true motion, {with_none:.4} px with none", pairs.len());
     assert!(with_truth < 0.75 * with_none, "{with_truth} against {with_none}");
     // Least squares over the cues the truth explains to within 0.3 px: the measured cues are the
-    // predicted ones, not a fraction or a multiple of them.
+    // predicted ones, not a fraction or a multiple of them. Bilinear resampling made them 1.067
+    // of the prediction: it carries a match a near-constant 0.01 px too far when the true
+    // displacement is a small fraction of a pixel, as a cue is sideways.
     let (num, den) = pairs
         .iter()
         .filter(|(m, p)| (m.0 - p.0).hypot(m.1 - p.1) < 0.3)
         .fold((0.0, 0.0), |(n, d), (m, p)| (n + m.0 * p.0 + m.1 * p.1, d + p.0 * p.0 + p.1 * p.1));
-    assert!((num / den - 1.0).abs() < 0.1, "share {}", num / den);
+    eprintln!("measured cues {:.3} of the predicted ones", num / den);
+    assert!((num / den - 1.0).abs() < 0.03, "share {}", num / den);
 }
 
 #[test]
