@@ -70,7 +70,7 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
     columns.dedup();
     for col in columns {
         let targets: Vec<(ViewId, SplineImage)> =
-            views.iter().filter(|v| v.col == col).filter_map(|&v| Some((v, SplineImage::new(&scene.view(v)?.to_grey(), 0)))).collect();
+            views.iter().filter(|v| v.col == col).filter_map(|&v| Some((v, SplineImage::new(scene.view(v)?)))).collect();
         let Some(row_img) = scene.view(ViewId { row: centre.row, col }).filter(|_| !targets.is_empty()) else { continue };
         let a = grid.offset(ViewId { row: centre.row, col }).0;
         // The disparity is measured against the row view farthest from this one: a match's
@@ -78,7 +78,7 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
         // over in the vertical cue.
         let Some((partner, baseline)) = longest_row_baseline(scene, col) else { continue };
         let row_img = row_img.to_grey();
-        let partner = SplineImage::new(&partner.to_grey(), 0);
+        let partner = SplineImage::new(partner);
         let points = textured_points(&row_img, settings.radius, stride, 0.1);
         // The patch of the row view, found in the partner view `baseline d` to the right: `d`.
         let to_partner = |(x, y): (usize, usize), start: f64, slope: (f64, f64)| {

@@ -1,4 +1,4 @@
-//! A grey image resampled by cubic B-spline interpolation, for sub-pixel matching.
+//! An image's luminance resampled by cubic B-spline interpolation, for sub-pixel matching.
 //!
 //! Bilinear (and Keys cubic) interpolation shifts the phase of image texture by an amount that
 //! depends on the fractional part `f` of the sampling position: a texture of frequency `ω`
@@ -13,7 +13,7 @@ use crate::io::Raster;
 /// The pole of the cubic B-spline's interpolation prefilter, `√3 - 2`.
 const POLE: f64 = -0.267_949_192_431_122_7;
 
-/// One channel of a raster as the coefficients of the cubic B-spline that passes through its
+/// The luminance of a raster as the coefficients of the cubic B-spline that passes through its
 /// samples, with mirror-symmetric boundaries.
 #[derive(Debug, Clone)]
 pub struct SplineImage {
@@ -25,10 +25,11 @@ pub struct SplineImage {
 }
 
 impl SplineImage {
-    /// The spline through channel `ch` of `image` (the grey value of a grey raster: `ch = 0`).
-    pub fn new(image: &Raster, ch: usize) -> Self {
-        let (w, h) = (image.width, image.height);
-        let mut coefficients: Vec<f64> = (0..w * h).map(|i| image.get(i % w, i / w, ch) as f64).collect();
+    /// The spline through the luminance of `image` (its value, when it is grey).
+    pub fn new(image: &Raster) -> Self {
+        let grey = image.to_grey();
+        let (w, h) = (grey.width, grey.height);
+        let mut coefficients: Vec<f64> = grey.data.iter().map(|&v| v as f64).collect();
         for row in coefficients.chunks_exact_mut(w.max(1)) {
             prefilter(row);
         }
@@ -121,7 +122,7 @@ mod tests {
     #[test]
     fn the_spline_passes_through_every_sample() {
         let image = raster(23, 17, |x, y| ((0.9 * x + 0.4 * y).sin() + (1.3 * y - 0.7 * x).cos()) * 0.25 + 0.5);
-        let spline = SplineImage::new(&image, 0);
+        let spline = SplineImage::new(&image);
         for y in 0..17 {
             for x in 0..23 {
                 let s = spline.sample(x as f64, y as f64).unwrap();
@@ -137,7 +138,7 @@ mod tests {
         // bilinear interpolation is about f (1 - 3f) ω²/6, 0.012 px at f = 0.1 and ω = 1.
         let omega = 1.0;
         let image = raster(64, 8, |x, _| (omega * x).cos());
-        let spline = SplineImage::new(&image, 0);
+        let spline = SplineImage::new(&image);
         for f in [0.05, 0.1, 0.2, 0.3, 0.5, 0.8] {
             // The least-squares fit A cos(ω x) + B sin(ω x) over the middle of the row: the
             // resampled wave is cos(ω (x + s)) for A = cos(ω s), B = -sin(ω s).

@@ -93,9 +93,9 @@ pub fn textured_points(grey: &Raster, radius: usize, stride: usize, share: f64) 
 }
 
 /// Tracks the patch of the grey image `from` centred on the integer pixel `at` into `to` (the
-/// spline of a grey image of the same size), starting at displacement `guess`. `None` when the patch is flat or leaves either
-/// image, the iteration does not settle, or it ends farther than `settings.max_correction`
-/// from the guess.
+/// spline of an image of the same size), starting at displacement `guess`. `None` when the
+/// patch is flat or leaves either image, the iteration does not settle, or it ends farther than
+/// `settings.max_correction` from the guess.
 pub fn track(from: &Raster, to: &SplineImage, at: (usize, usize), guess: (f64, f64), settings: &TrackSettings) -> Option<Track> {
     track_warped(from, to, at, guess, [[0.0; 2]; 2], settings)
 }
@@ -166,15 +166,10 @@ mod tests {
         Raster { width: w, height: h, channels: 1, data }
     }
 
-    /// `texture`'s spline, the form the second view of a match takes.
-    fn spline(r: &Raster) -> SplineImage {
-        SplineImage::new(r, 0)
-    }
-
     #[test]
     fn a_known_subpixel_shift_is_recovered() {
         let from = texture(64, 64, 0.0, 0.0);
-        let to = spline(&texture(64, 64, 2.37, -1.62));
+        let to = SplineImage::new(&texture(64, 64, 2.37, -1.62));
         let t = track(&from, &to, (32, 30), (2.0, -1.0), &TrackSettings::default()).unwrap();
         assert!((t.displacement.0 - 2.37).abs() < 2e-3 && (t.displacement.1 + 1.62).abs() < 2e-3, "{t:?}");
         assert!(t.residual_rms < 1e-3, "{t:?}");
@@ -194,7 +189,7 @@ mod tests {
             Raster { width: 48, height: 48, channels: 1, data }
         };
         for shift in [0.05, 0.1, -0.1, 0.2] {
-            let t = track(&fine(0.0), &spline(&fine(shift)), (24, 24), (0.0, 0.0), &TrackSettings::default()).unwrap();
+            let t = track(&fine(0.0), &SplineImage::new(&fine(shift)), (24, 24), (0.0, 0.0), &TrackSettings::default()).unwrap();
             assert!((t.displacement.0 - shift).abs() < 2.5e-3 && t.displacement.1.abs() < 2.5e-3, "{shift}: {t:?}");
         }
     }
@@ -211,7 +206,7 @@ mod tests {
             Raster { width: 64, height: 64, channels: 1, data }
         };
         let from = image(&f);
-        let to = spline(&image(&|x, y| f(x - shift.0, c + (y - c - shift.1) / (1.0 + stretch))));
+        let to = SplineImage::new(&image(&|x, y| f(x - shift.0, c + (y - c - shift.1) / (1.0 + stretch))));
         let settings = TrackSettings::default();
         let plain = track(&from, &to, (32, 32), (0.0, -2.0), &settings).unwrap().displacement;
         let warped = track_warped(&from, &to, (32, 32), (0.0, -2.0), [[0.0, 0.0], [0.0, stretch]], &settings).unwrap().displacement;
@@ -226,7 +221,7 @@ mod tests {
         let data = (0..48 * 48).map(|i| (0.5 + 0.4 * ((i % 48) as f64 * 0.5).sin()) as f32).collect();
         let stripes = Raster { width: 48, height: 48, channels: 1, data };
         assert!(textured_points(&stripes, 4, 4, 0.1).is_empty());
-        assert!(track(&stripes, &spline(&stripes), (24, 24), (0.0, 0.0), &TrackSettings::default()).is_none());
+        assert!(track(&stripes, &SplineImage::new(&stripes), (24, 24), (0.0, 0.0), &TrackSettings::default()).is_none());
         let tex = texture(48, 48, 0.0, 0.0);
         assert!(!textured_points(&tex, 4, 4, 0.1).is_empty());
     }
@@ -234,7 +229,7 @@ mod tests {
     #[test]
     fn a_patch_leaving_the_image_or_too_far_from_the_guess_is_lost() {
         let from = texture(40, 40, 0.0, 0.0);
-        let to = spline(&texture(40, 40, 3.0, 0.0));
+        let to = SplineImage::new(&texture(40, 40, 3.0, 0.0));
         assert!(track(&from, &to, (2, 20), (0.0, 0.0), &TrackSettings::default()).is_none());
         // The truth is 3 px away from a zero guess, beyond the allowed correction.
         let tight = TrackSettings { max_correction: 1.0, ..TrackSettings::default() };
