@@ -51,12 +51,12 @@ impl SplineImage {
         }
         let (x0, y0) = (x.floor(), y.floor());
         let (wx, wy) = (weights(x - x0), weights(y - y0));
+        // The four columns' indices are the same in every row.
+        let cols: [usize; 4] = std::array::from_fn(|i| mirror(x0 as isize + i as isize - 1, w));
         let mut sum = 0.0;
         for (j, wy) in wy.iter().enumerate() {
-            let row = mirror(y0 as isize + j as isize - 1, h) * w;
-            let along: f64 =
-                wx.iter().enumerate().map(|(i, wx)| wx * self.coefficients[row + mirror(x0 as isize + i as isize - 1, w)]).sum();
-            sum += wy * along;
+            let row = &self.coefficients[mirror(y0 as isize + j as isize - 1, h) * w..];
+            sum += wy * wx.iter().zip(&cols).map(|(wx, &c)| wx * row[c]).sum::<f64>();
         }
         Some(sum)
     }
