@@ -68,6 +68,8 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
     let mut columns: Vec<usize> = views.iter().map(|v| v.col).collect();
     columns.sort();
     columns.dedup();
+    // The partner views, splined once each: the columns on one side of the centre share one.
+    let mut partners: HashMap<ViewId, SplineImage> = HashMap::new();
     for col in columns {
         let targets: Vec<(ViewId, SplineImage)> =
             views.iter().filter(|v| v.col == col).filter_map(|&v| Some((v, SplineImage::new(scene.view(v)?)))).collect();
@@ -77,13 +79,14 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
         // own bias (a fixed fraction of a pixel) divides by the baseline, and returns `b` times
         // over in the vertical cue.
         let Some((partner, baseline)) = longest_row_baseline(scene, col) else { continue };
+        let Some(partner_img) = scene.view(partner) else { continue };
+        let partner = &*partners.entry(partner).or_insert_with(|| SplineImage::new(partner_img));
         let row_img = row_img.to_grey();
-        let partner = SplineImage::new(partner);
         let points = textured_points(&row_img, settings.radius, stride, 0.1);
         // The patch of the row view, found in the partner view `baseline d` to the right: `d`.
         let to_partner = |(x, y): (usize, usize), start: f64, slope: (f64, f64)| {
             let linear = [[baseline * slope.0, baseline * slope.1], [0.0, 0.0]];
-            let found = track_warped(&row_img, &partner, (x, y), (baseline * start, 0.0), linear, &settings)?.displacement;
+            let found = track_warped(&row_img, partner, (x, y), (baseline * start, 0.0), linear, &settings)?.displacement;
             (found.1.abs() <= 0.25).then_some(found.0 / baseline)
         };
         let first: Vec<Option<f64>> = points
@@ -117,15 +120,16 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
     cues
 }
 
-/// The view of the central row farthest from column `col`'s, and the baseline `B` between them
-/// (views): a patch of disparity `d` in column `col`'s view is `B d` to the right in it.
-fn longest_row_baseline(scene: &Scene, col: usize) -> Option<(&Raster, f64)> {
+/// The present view of the central row farthest from column `col`'s, and the baseline `B`
+/// between them (views): a patch of disparity `d` in column `col`'s view is `B d` to the right
+/// in it.
+fn longest_row_baseline(scene: &Scene, col: usize) -> Option<(ViewId, f64)> {
     let a = scene.grid.offset(ViewId { row: scene.central_id().row, col }).0;
     scene
         .central_row_views()
         .into_iter()
         .filter(|v| v.col != col)
-        .filter_map(|v| Some((scene.view(v)?, a - scene.grid.offset(v).0)))
+        .map(|v| (v, a - scene.grid.offset(v).0))
         .max_by(|p, q| p.1.abs().total_cmp(&q.1.abs()))
 }
 
