@@ -200,8 +200,8 @@ pub struct Stage2Config {
     pub cue_weight: f64,
     /// The least support (0..1) the cues measured between the views must give the estimated
     /// motion for it to be kept: the noise-weighted least-squares scale of the estimate's
-    /// predicted cues that fits the measured ones (1: borne out, 0: no such motion seen). Under
-    /// it by more than two standard errors, the estimate is taken for a drift of the photometric
+    /// predicted cues that fits the measured ones (1: borne out, 0: no such motion seen). Unless
+    /// it is over it by two standard errors, the estimate is taken for a drift of the photometric
     /// fit and no motion is kept. 0 = no check.
     pub min_cue_support: f64,
     /// The views the cues are measured in: `corners` or `all_off_row` (every present view off
