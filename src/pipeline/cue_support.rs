@@ -6,8 +6,8 @@
 //! The measured cues owe nothing to that model. The support of an estimate is the robust,
 //! noise-weighted least-squares scale `s` that best fits `s × predicted` to the measured cues:
 //! about 1 when they show the motion the estimate predicts, about 0 when they show none of it.
-//! Stage 2 sets a motion to none only when its support is clearly under a threshold
-//! ([`CueSupport::refutes`]).
+//! Stage 2 keeps a motion only when its support is clearly over a threshold
+//! ([`CueSupport::confirms`]).
 
 use super::measured_cues::{Cue, predicted_cue};
 use crate::geometry::Camera;
