@@ -51,11 +51,19 @@ impl SplineImage {
         }
         let (x0, y0) = (x.floor(), y.floor());
         let (wx, wy) = (weights(x - x0), weights(y - y0));
-        // The four columns' indices are the same in every row.
-        let cols: [usize; 4] = std::array::from_fn(|i| mirror(x0 as isize + i as isize - 1, w));
+        // The 4 x 4 taps' indices, reflected only where they leave the image.
+        let taps = |start: f64, n: usize| -> [usize; 4] {
+            let first = start as isize - 1;
+            if first >= 0 && first + 3 < n as isize {
+                std::array::from_fn(|i| first as usize + i)
+            } else {
+                std::array::from_fn(|i| mirror(first + i as isize, n))
+            }
+        };
+        let (cols, rows) = (taps(x0, w), taps(y0, h));
         let mut sum = 0.0;
-        for (j, wy) in wy.iter().enumerate() {
-            let row = &self.coefficients[mirror(y0 as isize + j as isize - 1, h) * w..];
+        for (wy, &r) in wy.iter().zip(&rows) {
+            let row = &self.coefficients[r * w..];
             sum += wy * wx.iter().zip(&cols).map(|(wx, &c)| wx * row[c]).sum::<f64>();
         }
         Some(sum)
