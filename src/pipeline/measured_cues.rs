@@ -78,7 +78,7 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
         // The disparity is measured against the row view farthest from this one: a match's
         // own bias (a fixed fraction of a pixel) divides by the baseline, and returns `b` times
         // over in the vertical cue.
-        let Some((partner, baseline)) = longest_row_baseline(scene, col) else { continue };
+        let Some((partner, baseline)) = longest_row_baseline(scene, a) else { continue };
         let Some(partner_img) = scene.view(partner) else { continue };
         let partner = &*partners.entry(partner).or_insert_with(|| SplineImage::new(partner_img));
         let row_img = row_img.to_grey();
@@ -120,16 +120,15 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
     cues
 }
 
-/// The present view of the central row farthest from column `col`'s, and the baseline `B`
-/// between them (views): a patch of disparity `d` in column `col`'s view is `B d` to the right
-/// in it.
-fn longest_row_baseline(scene: &Scene, col: usize) -> Option<(ViewId, f64)> {
-    let a = scene.grid.offset(ViewId { row: scene.central_id().row, col }).0;
+/// The present view of the central row farthest from the one `a` views right of the centre,
+/// and the baseline `B` between them (views): a patch of disparity `d` in the view at `a` is
+/// `B d` to the right in it.
+fn longest_row_baseline(scene: &Scene, a: f64) -> Option<(ViewId, f64)> {
     scene
         .central_row_views()
         .into_iter()
-        .filter(|v| v.col != col)
         .map(|v| (v, a - scene.grid.offset(v).0))
+        .filter(|&(_, baseline)| baseline != 0.0)
         .max_by(|p, q| p.1.abs().total_cmp(&q.1.abs()))
 }
 

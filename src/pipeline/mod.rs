@@ -378,10 +378,12 @@ fn stage2(
         ));
         cues
     });
-    let cue_term = cues
-        .as_ref()
-        .filter(|_| s.cue_weight > 0.0)
-        .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, device));
+    // The term is built where a fit uses it: a motion the check sets to none needs none.
+    let cue_term = || {
+        cues.as_ref()
+            .filter(|_| s.cue_weight > 0.0)
+            .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, device))
+    };
     let mut views = stage2_views(scene, s.views);
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
@@ -437,17 +439,17 @@ fn stage2(
         fitted
     };
     let checked_cues = cues.as_ref().filter(|_| check);
-    let first_cue_term = if checked_cues.is_some() { None } else { cue_term.as_ref() };
-    let mut fitted = phase("fit", gaussians.clone(), first_cue_term, log);
+    let first_cue_term = if checked_cues.is_some() { None } else { cue_term() };
+    let mut fitted = phase("fit", gaussians.clone(), first_cue_term.as_ref(), log);
     curves.push(("stage2".to_string(), fitted.curve.clone()));
-    let Some(cues) = checked_cues else { return fitted };
-    let confirmed = check_motion(&mut fitted, model, camera, cues, s.min_cue_support, log);
-    if let Some(term) = cue_term.as_ref().filter(|_| confirmed) {
+    let Some(checked) = checked_cues else { return fitted };
+    let confirmed = check_motion(&mut fitted, model, camera, checked, s.min_cue_support, log);
+    if let Some(term) = confirmed.then(cue_term).flatten() {
         // Only a motion the cues clearly show: fitted to the cues, a still scene's drift does not
         // shrink (the 256 px suite's still scenes end 0.22-0.81 px off; docs/results.md). From the
         // start again, not from the photometric estimate: started there, the fit stays near it
         // (objects_accel, constant_acceleration: 1.22 px against 0.51 px).
-        fitted = phase("fit with the measured cues", gaussians, Some(term), log);
+        fitted = phase("fit with the measured cues", gaussians, Some(&term), log);
         curves.push(("stage2_cues".to_string(), fitted.curve.clone()));
     }
     fitted
