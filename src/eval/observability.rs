@@ -187,7 +187,7 @@ mod tests {
 
     /// Depth `z(u, v)` at every pixel.
     fn depth(z: impl Fn(usize, usize) -> f32) -> Raster {
-        Raster { width: 64, height: 64, channels: 1, data: (0..64 * 64).map(|i| z(i % 64, i / 64)).collect() }
+        Raster::from_fn(64, 64, z)
     }
 
     #[test]

@@ -21,6 +21,11 @@ impl Raster {
         Self { width, height, channels, data: vec![0.0; width * height * channels] }
     }
 
+    /// A one-channel raster whose pixel (x, y) is `f(x, y)`.
+    pub fn from_fn(width: usize, height: usize, f: impl Fn(usize, usize) -> f32) -> Self {
+        Self { width, height, channels: 1, data: (0..width * height).map(|i| f(i % width, i / width)).collect() }
+    }
+
     /// Wraps `data`; `None` when its length does not match the size.
     pub fn from_vec(width: usize, height: usize, channels: usize, data: Vec<f32>) -> Option<Self> {
         (data.len() == width * height * channels).then_some(Self { width, height, channels, data })

@@ -41,10 +41,6 @@ pub fn aperture_weights(image: &Raster, radius: usize, eps: f32) -> Raster {
 mod tests {
     use super::*;
 
-    fn image(w: usize, h: usize, f: impl Fn(usize, usize) -> f32) -> Raster {
-        Raster { width: w, height: h, channels: 1, data: (0..w * h).map(|i| f(i % w, i / w)).collect() }
-    }
-
     fn at(r: &Raster, x: usize, y: usize) -> f32 {
         r.data[y * r.width + x]
     }
@@ -53,10 +49,10 @@ mod tests {
     fn horizontal_edges_weigh_nothing_vertical_edges_everything_flat_and_texture_half() {
         let eps = 1e-4;
         // Stripes 4 px wide: horizontal ones vary along y only, vertical ones along x only.
-        let horizontal = aperture_weights(&image(32, 32, |_, y| ((y / 4) % 2) as f32), 2, eps);
-        let vertical = aperture_weights(&image(32, 32, |x, _| ((x / 4) % 2) as f32), 2, eps);
-        let flat = aperture_weights(&image(32, 32, |_, _| 0.3), 2, eps);
-        let checker = aperture_weights(&image(32, 32, |x, y| ((x / 4 + y / 4) % 2) as f32), 2, eps);
+        let horizontal = aperture_weights(&Raster::from_fn(32, 32, |_, y| ((y / 4) % 2) as f32), 2, eps);
+        let vertical = aperture_weights(&Raster::from_fn(32, 32, |x, _| ((x / 4) % 2) as f32), 2, eps);
+        let flat = aperture_weights(&Raster::from_fn(32, 32, |_, _| 0.3), 2, eps);
+        let checker = aperture_weights(&Raster::from_fn(32, 32, |x, y| ((x / 4 + y / 4) % 2) as f32), 2, eps);
         for (x, y) in [(10, 8), (16, 16), (20, 11)] {
             assert!(at(&horizontal, x, y) < 1e-3, "horizontal edge at ({x}, {y}): {}", at(&horizontal, x, y));
             assert!(at(&vertical, x, y) > 0.999, "vertical edge at ({x}, {y}): {}", at(&vertical, x, y));
@@ -71,7 +67,7 @@ mod tests {
 
     #[test]
     fn colour_is_weighed_by_its_luminance() {
-        let grey = image(16, 16, |x, y| ((x + 2 * y) % 5) as f32 / 5.0);
+        let grey = Raster::from_fn(16, 16, |x, y| ((x + 2 * y) % 5) as f32 / 5.0);
         let rgb = Raster { width: 16, height: 16, channels: 3, data: grey.data.iter().flat_map(|&v| [v, v, v]).collect() };
         let (a, b) = (aperture_weights(&grey, 1, 1e-4), aperture_weights(&rgb, 1, 1e-4));
         assert!(a.data.iter().zip(&b.data).all(|(p, q)| (p - q).abs() < 1e-5));

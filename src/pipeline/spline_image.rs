@@ -123,8 +123,7 @@ mod tests {
     use super::*;
 
     fn raster(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Raster {
-        let data = (0..w * h).map(|i| f((i % w) as f64, (i / w) as f64) as f32).collect();
-        Raster { width: w, height: h, channels: 1, data }
+        Raster::from_fn(w, h, |x, y| f(x as f64, y as f64) as f32)
     }
 
     #[test]

@@ -80,10 +80,6 @@ pub fn masked(rendered: RenderOutput, target: Tensor<2>, mask: Tensor<2>) -> (Re
 mod tests {
     use super::*;
 
-    fn map(w: usize, h: usize, d: impl Fn(usize, usize) -> f32) -> Raster {
-        Raster { width: w, height: h, channels: 1, data: (0..w * h).map(|i| d(i % w, i / w)).collect() }
-    }
-
     fn left_out(mask: &Raster) -> usize {
         mask.data.iter().filter(|&&m| m == 0.0).count()
     }
@@ -97,7 +93,8 @@ mod tests {
     #[test]
     fn without_motion_the_moving_mask_is_the_static_one() {
         let cam = camera();
-        let disparity = map(40, 30, |x, y| if (10..22).contains(&x) && (8..20).contains(&y) { 1.3 } else { 0.1 + 0.01 * x as f32 });
+        let disparity =
+            Raster::from_fn(40, 30, |x, y| if (10..22).contains(&x) && (8..20).contains(&y) { 1.3 } else { 0.1 + 0.01 * x as f32 });
         let view = ViewId { row: 8, col: 1 };
         let (dx, dy) = cam.grid.offset(view);
         let moving = explained_mask_moving(&disparity, &cam, view, &MotionRecord::zero(), 1);
@@ -113,7 +110,7 @@ mod tests {
         // f v 3.6 ms / z to the right: 3.5 px for the v set here. Rows 0-2 and columns 0-2 are
         // left uncovered.
         let cam = camera();
-        let disparity = map(40, 30, |_, _| 0.9);
+        let disparity = Raster::from_fn(40, 30, |_, _| 0.9);
         let v = 3.5 * cam.disparity_to_depth(0.9) / (cam.f_px * 3.6 * cam.line_time_s);
         let motion = MotionRecord::ConstantVelocity { omega_rad_s: [0.0; 3], velocity_m_s: [v, 0.0, 0.0] };
         let mask = explained_mask_moving(&disparity, &cam, ViewId { row: 0, col: 4 }, &motion, 0);
@@ -126,14 +123,14 @@ mod tests {
 
     #[test]
     fn the_central_view_itself_keeps_every_pixel() {
-        let disparity = map(32, 24, |x, y| 0.1 * x as f32 - 0.05 * y as f32);
+        let disparity = Raster::from_fn(32, 24, |x, y| 0.1 * x as f32 - 0.05 * y as f32);
         assert_eq!(left_out(&explained_mask(&disparity, (0.0, 0.0), 3)), 0);
     }
 
     #[test]
     fn a_view_beside_the_central_one_leaves_out_the_strip_entering_at_its_border() {
         // A plane of disparity 1 seen 4 views to the left (dx = -4) lands 4 px further right.
-        let disparity = map(40, 10, |_, _| 1.0);
+        let disparity = Raster::from_fn(40, 10, |_, _| 1.0);
         let mask = explained_mask(&disparity, (-4.0, 0.0), 0);
         for y in 0..10 {
             let row = &mask.data[y * 40..(y + 1) * 40];
@@ -150,7 +147,7 @@ mod tests {
         // A square of disparity 2 before a background of disparity 0, seen from the top-left
         // corner (dx = dy = -4): it moves 8 px right and down; the background behind its old
         // top-left part is what no central pixel shows.
-        let disparity = map(48, 48, |x, y| if (15..25).contains(&x) && (15..25).contains(&y) { 2.0 } else { 0.0 });
+        let disparity = Raster::from_fn(48, 48, |x, y| if (15..25).contains(&x) && (15..25).contains(&y) { 2.0 } else { 0.0 });
         let mask = explained_mask(&disparity, (-4.0, -4.0), 0);
         let at = |x: usize, y: usize| mask.data[y * 48 + x];
         assert_eq!(at(19, 19), 0.0, "uncovered background");
