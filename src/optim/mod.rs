@@ -8,11 +8,13 @@
 //! `pipeline::fit_stage2`); `examples/fit_image.rs` uses them to fit 2D Gaussians to one image.
 
 mod mean_loss;
+mod newton;
 mod plan;
 mod schedule;
 mod stage;
 
 pub use mean_loss::MeanLoss;
+pub use newton::{NewtonReport, NewtonSettings, newton_minimise};
 pub use plan::{GroupPlan, Optimiser, Plan};
 pub use schedule::Schedule;
 pub use stage::{Objective, Stage, StepReport, optimise};

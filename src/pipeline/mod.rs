@@ -37,12 +37,18 @@ use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::{LossRegistry, WeightedLosses};
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
+use crate::optim::NewtonSettings;
 use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, splat};
 use burn::tensor::{Device, Tensor, TensorData};
 use std::time::Instant;
 
 /// Residual (px) beyond which a measured cue counts linearly in the cue term.
 const CUE_HUBER_PX: f32 = 0.1;
+
+/// Finite-difference step (scaled units: about a pixel of image motion each) of the stage-2
+/// Newton steps' Hessian, and their longest step.
+const NEWTON_FD_STEP: f64 = 0.05;
+const NEWTON_MAX_STEP: f64 = 2.0;
 
 /// Opacity above which a rendered pixel's blended disparity is trusted over the initial map.
 const TRUSTED_ALPHA: f32 = 0.5;
@@ -405,19 +411,43 @@ fn stage2(
         refine,
         disocclusion_margin: s.mask_disocclusions.then_some(s.disocclusion_margin),
         aperture_weighting: s.aperture_weighting,
+        // No Adam steps, no estimation: a given `initial_motion` is used as it is.
+        newton: NewtonSettings {
+            iterations: if s.iterations > 0 { s.newton_iterations } else { 0 },
+            fd_step: NEWTON_FD_STEP,
+            max_step: NEWTON_MAX_STEP,
+        },
     };
-    // One phase of the fit, with its progress bar and its line in the log.
-    let phase = |what: &str, g: Gaussians, cue_term: Option<&CueTerm>, log: &mut RunLog| {
+    // One phase of the fit, with its progress bar and its line in the log. The Newton steps go to
+    // the last (`last`), whose motion is kept: the second when the check may confirm the motion
+    // for one, so the check judges the same fit with or without them.
+    let phase = |what: &str, g: Gaussians, cue_term: Option<&CueTerm>, last: bool, log: &mut RunLog| {
         let bar = crate::progress::bar(s.iterations as u64, &format!("stage 2: {what}"));
         let start = Instant::now();
-        let fitted =
-            fit_stage2(g, scene, camera, &views, model, start_values, &fit, losses, device, stage1_disparity, cue_term, |done, _, loss| {
-                bar.set_position(done as u64);
-                bar.set_message(format!("stage 2 ({what}): loss {loss:.4}"));
-            });
+        let fit = if last { fit.clone() } else { Stage2Fit { newton: NewtonSettings { iterations: 0, ..fit.newton }, ..fit.clone() } };
+        let fitted = fit_stage2(
+            g,
+            scene,
+            camera,
+            &views,
+            model,
+            start_values,
+            &fit,
+            losses,
+            device,
+            stage1_disparity,
+            cue_term,
+            |done, of, loss| {
+                bar.set_position(done.min(of) as u64);
+                bar.set_message(match done.checked_sub(of).filter(|&k| k > 0) {
+                    None => format!("stage 2 ({what}): loss {loss:.4}"),
+                    Some(k) => format!("stage 2 ({what}): Newton steps, objective {loss:.5} ({k} evaluations)"),
+                });
+            },
+        );
         bar.finish_and_clear();
         log.lines.push(format!(
-            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4}, {:.1} s",
+            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4}{}, {:.1} s",
             model.name(),
             s.iterations,
             s.bands_per_step,
@@ -434,13 +464,18 @@ fn stage2(
             losses.names().join(" + "),
             fitted.curve.first().copied().unwrap_or(f32::NAN),
             fitted.curve.last().copied().unwrap_or(f32::NAN),
+            fitted.newton.map_or(String::new(), |r| format!(
+                ", then {} of {} Newton steps taken over every band, {:.5} -> {:.5} ({} evaluations)",
+                r.taken, s.newton_iterations, r.start, r.end, r.evaluations
+            )),
             start.elapsed().as_secs_f64()
         ));
         fitted
     };
     let checked_cues = cues.as_ref().filter(|_| check);
     let first_cue_term = if checked_cues.is_some() { None } else { cue_term() };
-    let mut fitted = phase("fit", gaussians.clone(), first_cue_term.as_ref(), log);
+    let second_fit = checked_cues.is_some() && s.cue_weight > 0.0;
+    let mut fitted = phase("fit", gaussians.clone(), first_cue_term.as_ref(), !second_fit, log);
     curves.push(("stage2".to_string(), fitted.curve.clone()));
     let Some(checked) = checked_cues else { return fitted };
     let confirmed = check_motion(&mut fitted, model, camera, checked, s.min_cue_support, log);
@@ -449,7 +484,7 @@ fn stage2(
         // shrink (the 256 px suite's still scenes end 0.22-0.81 px off; docs/results.md). From the
         // start again, not from the photometric estimate: started there, the fit stays near it
         // (objects_accel, constant_acceleration: 1.22 px against 0.51 px).
-        fitted = phase("fit with the measured cues", gaussians, Some(&term), log);
+        fitted = phase("fit with the measured cues", gaussians, Some(&term), true, log);
         curves.push(("stage2_cues".to_string(), fitted.curve.clone()));
     }
     fitted

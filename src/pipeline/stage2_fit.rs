@@ -12,11 +12,11 @@ use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionParams, ScaleContext, parameter_scales};
-use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
+use crate::optim::{GroupPlan, MeanLoss, NewtonReport, NewtonSettings, Plan, Schedule, Stage, StepReport, newton_minimise, optimise};
 use crate::random::Rng;
 use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, bands, splat};
 use burn::module::Module;
-use burn::tensor::{Device, Tensor};
+use burn::tensor::{Device, Tensor, TensorData};
 
 /// Settings of the stage-2 fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,6 +50,8 @@ pub struct Stage2Fit {
     /// residual, so that residuals a disparity error could equally have caused do not pull the
     /// motion; under joint refinement the Gaussians still compare every pixel.
     pub aperture_weighting: bool,
+    /// Damped Newton steps on the motion after Adam's, over every band (0 iterations = none).
+    pub newton: NewtonSettings,
 }
 
 /// Steps between two redrawings of the disocclusion masks from the current motion.
@@ -76,6 +78,8 @@ pub struct MotionFit {
     /// The share of the compared views' pixels left in the loss by the last masks drawn (1 without
     /// masks).
     pub kept: f64,
+    /// What the Newton steps after Adam did, when there were any.
+    pub newton: Option<NewtonReport>,
 }
 
 /// One rendering of the compared views: the static shape and motion parameters it is drawn with
@@ -127,7 +131,8 @@ fn stratified(total: usize, count: usize, rng: &mut Rng) -> Vec<usize> {
 /// `g` are held fixed unless `fit.refine` is set. With `fit.disocclusion_margin` set, the
 /// disocclusion masks are derived from `central_disparity` (the central view's disparity, e.g.
 /// the stage-1 render) and the current motion estimate; without a map no pixel is masked.
-/// `progress(step, total, loss)` is called after each step.
+/// `progress(step, total, loss)` is called after each Adam step, and after each evaluation of
+/// the Newton steps (with `step` past `total`).
 #[allow(clippy::too_many_arguments)]
 pub fn fit_stage2(
     g: Gaussians,
@@ -184,6 +189,56 @@ pub fn fit_stage2(
     let stage = Stage { iterations: fit.iterations, plan };
     let initial = MotionAndScene { motion: MotionParams::new(start, &scales, device), gaussians: g };
     let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
+    // The photometric loss of the bands `bands_of` chooses in each view (in turn), each view
+    // rendered by `joint`, or by both passes of `split` where its aperture weights apply.
+    let compare = |joint: &Pass,
+                   split: Option<&[Pass; 2]>,
+                   masks: Option<&Vec<Vec<Tensor<2>>>>,
+                   scaled: &Tensor<1>,
+                   bands_of: &mut dyn FnMut() -> Vec<usize>| {
+        let mut loss = MeanLoss::default();
+        for (v, (ViewTarget { offset, .. }, view_bands)) in targets.iter().zip(&band_targets).enumerate() {
+            let passes: &[Pass] = match (&aperture[v], split) {
+                (Some(_), Some(split)) => split,
+                _ => std::slice::from_ref(joint),
+            };
+            let rolling: Vec<Option<Splats>> = passes
+                .iter()
+                .map(|p| match fit.timing {
+                    RsTiming::PerGaussian(iterations) => Some(p.shape.splats_rolling(model, p.params.clone(), *offset, iterations)),
+                    RsTiming::Bands(_) => None,
+                })
+                .collect();
+            for b in bands_of() {
+                let (rows, tau) = all_bands[b].clone();
+                let mut band_loss = MeanLoss::default();
+                for (pass, rolling) in passes.iter().zip(&rolling) {
+                    let splats = match rolling {
+                        Some(s) => s.clone(),
+                        None => pass.shape.splats_at_time(model, pass.params.clone(), *offset, tau.expect("bands have a time")),
+                    };
+                    let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
+                    let (out, target) = match masks {
+                        Some(masks) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
+                        None => (out, view_bands[b].clone()),
+                    };
+                    let (out, target) = match (&aperture[v], pass.weighted) {
+                        (Some(weights), true) => masked(out, target, weights[b].clone()),
+                        _ => (out, target),
+                    };
+                    let motion = pass.prior.then_some(scaled);
+                    band_loss.add(losses.evaluate(&LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion }));
+                }
+                // A band counts once; with two passes, their losses are summed.
+                loss.add(band_loss.sum());
+            }
+        }
+        loss.mean()
+    };
+    let with_cues = |photometric: Option<Tensor<1>>, params: Tensor<1>| match cues {
+        Some(cues) => photometric.map(|l| l + cues.evaluate(tc, model, params)),
+        None => photometric,
+    };
     let objective = |m: &MotionAndScene, step: usize| {
         if masks.is_some() && step > 0 && step.is_multiple_of(MASK_REFRESH) {
             masks = draw_masks(&model.record(&m.motion.si_values(&scales)));
@@ -211,50 +266,44 @@ pub fn fit_stage2(
                 },
             ]
         });
-        let mut loss = MeanLoss::default();
-        for (v, (ViewTarget { offset, .. }, view_bands)) in targets.iter().zip(&band_targets).enumerate() {
-            let passes: &[Pass] = match (&aperture[v], &split) {
-                (Some(_), Some(split)) => split,
-                _ => std::slice::from_ref(&joint),
-            };
-            let rolling: Vec<Option<Splats>> = passes
-                .iter()
-                .map(|p| match fit.timing {
-                    RsTiming::PerGaussian(iterations) => Some(p.shape.splats_rolling(model, p.params.clone(), *offset, iterations)),
-                    RsTiming::Bands(_) => None,
-                })
-                .collect();
-            for b in stratified(all_bands.len(), fit.bands_per_step, &mut rng) {
-                let (rows, tau) = all_bands[b].clone();
-                let mut band_loss = MeanLoss::default();
-                for (pass, rolling) in passes.iter().zip(&rolling) {
-                    let splats = match rolling {
-                        Some(s) => s.clone(),
-                        None => pass.shape.splats_at_time(model, pass.params.clone(), *offset, tau.expect("bands have a time")),
-                    };
-                    let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
-                    let (out, target) = match &masks {
-                        Some((_, masks)) => masked(out, view_bands[b].clone(), masks[v][b].clone()),
-                        None => (out, view_bands[b].clone()),
-                    };
-                    let (out, target) = match (&aperture[v], pass.weighted) {
-                        (Some(weights), true) => masked(out, target, weights[b].clone()),
-                        _ => (out, target),
-                    };
-                    let motion = pass.prior.then_some(&scaled);
-                    band_loss.add(losses.evaluate(&LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion }));
-                }
-                // A band counts once; with two passes, their losses are summed.
-                loss.add(band_loss.sum());
-            }
-        }
-        let photometric = loss.mean();
-        match cues {
-            Some(cues) => photometric.map(|l| l + cues.evaluate(tc, model, params.clone())),
-            None => photometric,
-        }
+        let mut sample = || stratified(all_bands.len(), fit.bands_per_step, &mut rng);
+        let photometric = compare(&joint, split.as_ref(), masks.as_ref().map(|(_, m)| m), &scaled, &mut sample);
+        with_cues(photometric, params)
     };
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
+    let adam = fitted.motion.si_values(&scales);
+    // Newton steps on the motion alone (Gaussians held), over every band of every view: the
+    // objective the motion's Adam steps sample. Each evaluation is reported as a step beyond
+    // Adam's last.
+    let (parameters, newton) = if fit.newton.iterations > 0 {
+        let held = fitted.gaussians.clone().no_grad();
+        let n = scales.len();
+        let si = Tensor::<1>::from_data(TensorData::new(scales.iter().map(|&s| s as f32).collect(), [n]), device);
+        let every: Vec<usize> = (0..all_bands.len()).collect();
+        let masks = masks.as_ref().map(|(_, m)| m);
+        let mut evaluations = 0;
+        let eval = |x: &[f64]| {
+            let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
+            let params = scaled.clone() * si.clone();
+            let pass =
+                Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params: params.clone(), weighted: true, prior: true };
+            let Some(total) = with_cues(compare(&pass, None, masks, &scaled, &mut || every.clone()), params) else {
+                return (f64::NAN, vec![0.0; n]);
+            };
+            let value = total.clone().into_scalar::<f32>();
+            evaluations += 1;
+            progress(fit.iterations + evaluations, fit.iterations, value);
+            let gradient = scaled.grad(&total.backward()).map_or(vec![0.0; n], |g| {
+                g.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data").into_iter().map(f64::from).collect()
+            });
+            (value as f64, gradient)
+        };
+        let start: Vec<f64> = adam.iter().zip(&scales).map(|(p, s)| p / s).collect();
+        let (end, report) = newton_minimise(&start, &fit.newton, eval);
+        (end.iter().zip(&scales).map(|(x, s)| x * s).collect(), Some(report))
+    } else {
+        (adam, None)
+    };
     let kept = masks.map_or(1.0, |(kept, _)| kept);
-    MotionFit { parameters: fitted.motion.si_values(&scales), scales, curve, gaussians: fitted.gaussians, kept }
+    MotionFit { parameters, scales, curve, gaussians: fitted.gaussians, kept, newton }
 }
