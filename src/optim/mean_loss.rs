@@ -21,6 +21,11 @@ impl MeanLoss {
         }
     }
 
+    /// Number of terms added.
+    pub fn count(&self) -> usize {
+        self.count
+    }
+
     /// The sum of the terms added, or `None` when none was.
     pub fn sum(self) -> Option<Tensor<1>> {
         self.sum

@@ -189,15 +189,20 @@ pub fn fit_stage2(
     let stage = Stage { iterations: fit.iterations, plan };
     let initial = MotionAndScene { motion: MotionParams::new(start, &scales, device), gaussians: g };
     let mut rng = Rng::new(fit.seed ^ 0x5747_4532);
-    // The photometric loss of the bands `bands_of` chooses in each view (in turn), each view
-    // rendered by `joint`, or by both passes of `split` where its aperture weights apply.
+    // The photometric losses of the bands `bands_of(view)` chooses in each view (in turn; a view
+    // with none is not rendered), each view rendered by `joint`, or by both passes of `split`
+    // where its aperture weights apply.
     let compare = |joint: &Pass,
                    split: Option<&[Pass; 2]>,
                    masks: Option<&Vec<Vec<Tensor<2>>>>,
                    scaled: &Tensor<1>,
-                   bands_of: &mut dyn FnMut() -> Vec<usize>| {
+                   bands_of: &mut dyn FnMut(usize) -> Vec<usize>| {
         let mut loss = MeanLoss::default();
         for (v, (ViewTarget { offset, .. }, view_bands)) in targets.iter().zip(&band_targets).enumerate() {
+            let chosen = bands_of(v);
+            if chosen.is_empty() {
+                continue;
+            }
             let passes: &[Pass] = match (&aperture[v], split) {
                 (Some(_), Some(split)) => split,
                 _ => std::slice::from_ref(joint),
@@ -209,7 +214,7 @@ pub fn fit_stage2(
                     RsTiming::Bands(_) => None,
                 })
                 .collect();
-            for b in bands_of() {
+            for b in chosen {
                 let (rows, tau) = all_bands[b].clone();
                 let mut band_loss = MeanLoss::default();
                 for (pass, rolling) in passes.iter().zip(&rolling) {
@@ -233,7 +238,7 @@ pub fn fit_stage2(
                 loss.add(band_loss.sum());
             }
         }
-        loss.mean()
+        loss
     };
     let with_cues = |photometric: Option<Tensor<1>>, params: Tensor<1>| match cues {
         Some(cues) => photometric.map(|l| l + cues.evaluate(tc, model, params)),
@@ -266,8 +271,8 @@ pub fn fit_stage2(
                 },
             ]
         });
-        let mut sample = || stratified(all_bands.len(), fit.bands_per_step, &mut rng);
-        let photometric = compare(&joint, split.as_ref(), masks.as_ref().map(|(_, m)| m), &scaled, &mut sample);
+        let mut sample = |_| stratified(all_bands.len(), fit.bands_per_step, &mut rng);
+        let photometric = compare(&joint, split.as_ref(), masks.as_ref().map(|(_, m)| m), &scaled, &mut sample).mean();
         with_cues(photometric, params)
     };
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
@@ -278,25 +283,44 @@ pub fn fit_stage2(
     let (parameters, newton) = if fit.newton.iterations > 0 {
         let held = fitted.gaussians.clone().no_grad();
         let n = scales.len();
-        let si = Tensor::<1>::from_data(TensorData::new(scales.iter().map(|&s| s as f32).collect(), [n]), device);
         let every: Vec<usize> = (0..all_bands.len()).collect();
         let masks = masks.as_ref().map(|(_, m)| m);
         let mut evaluations = 0;
+        // One view at a time, each view's graph freed before the next: the gradient of the mean
+        // over every band is the sum of the views' gradients over the number of bands.
         let eval = |x: &[f64]| {
-            let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
-            let params = scaled.clone() * si.clone();
-            let pass =
-                Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params: params.clone(), weighted: true, prior: true };
-            let Some(total) = with_cues(compare(&pass, None, masks, &scaled, &mut || every.clone()), params) else {
-                return (f64::NAN, vec![0.0; n]);
+            let leaf = || Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
+            // Adds `term`'s value and its gradient with respect to `scaled` to `total`.
+            let add = |total: &mut (f64, Vec<f64>), term: Tensor<1>, scaled: Tensor<1>| {
+                total.0 += term.clone().into_scalar::<f32>() as f64;
+                if let Some(g) = scaled.grad(&term.backward()) {
+                    let g = g.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
+                    total.1.iter_mut().zip(g).for_each(|(a, b)| *a += b as f64);
+                }
             };
-            let value = total.clone().into_scalar::<f32>();
+            let mut photometric = (0.0, vec![0.0; n]);
+            let mut bands = 0;
+            for v in 0..targets.len() {
+                let scaled = leaf();
+                let params = MotionParams::to_si(scaled.clone(), &scales);
+                let pass = Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params, weighted: true, prior: true };
+                let part = compare(&pass, None, masks, &scaled, &mut |u| if u == v { every.clone() } else { Vec::new() });
+                bands += part.count();
+                if let Some(sum) = part.sum() {
+                    add(&mut photometric, sum, scaled);
+                }
+            }
+            if bands == 0 {
+                return (f64::NAN, vec![0.0; n]);
+            }
+            let mut total = (photometric.0 / bands as f64, photometric.1.iter().map(|g| g / bands as f64).collect());
+            if let Some(cues) = cues {
+                let scaled = leaf();
+                add(&mut total, cues.evaluate(tc, model, MotionParams::to_si(scaled.clone(), &scales)), scaled);
+            }
             evaluations += 1;
-            progress(fit.iterations + evaluations, fit.iterations, value);
-            let gradient = scaled.grad(&total.backward()).map_or(vec![0.0; n], |g| {
-                g.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data").into_iter().map(f64::from).collect()
-            });
-            (value as f64, gradient)
+            progress(fit.iterations + evaluations, fit.iterations, total.0 as f32);
+            total
         };
         let start: Vec<f64> = adam.iter().zip(&scales).map(|(p, s)| p / s).collect();
         let (end, report) = newton_minimise(&start, &fit.newton, eval);

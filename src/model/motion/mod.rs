@@ -90,10 +90,15 @@ impl MotionParams {
 
     /// The SI parameter vector as a tensor: `scaled * scales`.
     pub fn si(&self, scales: &[f64]) -> Tensor<1> {
+        Self::to_si(self.scaled.val(), scales)
+    }
+
+    /// The SI values of a scaled parameter vector `[P]` (on its autodiff graph, if any).
+    pub fn to_si(scaled: Tensor<1>, scales: &[f64]) -> Tensor<1> {
         let s: Vec<f32> = scales.iter().map(|&s| s as f32).collect();
         let n = s.len();
-        let device = self.scaled.val().device();
-        self.scaled.val() * Tensor::<1>::from_data(TensorData::new(s, [n]), &device)
+        let device = scaled.device();
+        scaled * Tensor::<1>::from_data(TensorData::new(s, [n]), &device)
     }
 
     /// The SI parameter vector on the host.
