@@ -240,10 +240,6 @@ pub fn fit_stage2(
         }
         loss
     };
-    let with_cues = |photometric: Option<Tensor<1>>, params: Tensor<1>| match cues {
-        Some(cues) => photometric.map(|l| l + cues.evaluate(tc, model, params)),
-        None => photometric,
-    };
     let objective = |m: &MotionAndScene, step: usize| {
         if masks.is_some() && step > 0 && step.is_multiple_of(MASK_REFRESH) {
             masks = draw_masks(&model.record(&m.motion.si_values(&scales)));
@@ -273,7 +269,10 @@ pub fn fit_stage2(
         });
         let mut sample = |_| stratified(all_bands.len(), fit.bands_per_step, &mut rng);
         let photometric = compare(&joint, split.as_ref(), masks.as_ref().map(|(_, m)| m), &scaled, &mut sample).mean();
-        with_cues(photometric, params)
+        match cues {
+            Some(cues) => photometric.map(|l| l + cues.evaluate(tc, model, params)),
+            None => photometric,
+        }
     };
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
     let adam = fitted.motion.si_values(&scales);
