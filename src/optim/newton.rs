@@ -4,7 +4,9 @@
 //! flat one. The Hessian comes from finite differences of the gradient (one gradient per
 //! parameter), so any objective that has a gradient will do; each step is damped
 //! (Levenberg–Marquardt) and taken only where it lowers the objective, so the result is never
-//! worse than the start.
+//! worse than the start. Directions far flatter than the steepest can be held: there the
+//! objective hardly tells one point from another, and a Newton step would go a long way on the
+//! strength of a gradient that is mostly noise or bias.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -17,6 +19,9 @@ pub struct NewtonSettings {
     pub fd_step: f64,
     /// Longest step (Euclidean, in the parameters' units); a longer one is shortened.
     pub max_step: f64,
+    /// Eigen-directions of the Hessian whose curvature is under this share of the steepest's
+    /// are held where they are (0 holds none).
+    pub min_curvature_ratio: f64,
 }
 
 /// What the steps did.
@@ -64,14 +69,23 @@ pub fn newton_minimise(x0: &[f64], settings: &NewtonSettings, mut eval: impl FnM
         }
         let hessian = (&hessian + hessian.transpose()) * 0.5;
         let diagonal_scale = (hessian.diagonal().abs().sum() / n as f64).max(f64::MIN_POSITIVE);
+        let eigen = hessian.symmetric_eigen();
+        let floor = settings.min_curvature_ratio * eigen.eigenvalues.max();
+        let free: Vec<usize> = (0..n).filter(|&k| settings.min_curvature_ratio <= 0.0 || eigen.eigenvalues[k] >= floor).collect();
         let mut taken = false;
         while damping <= DAMPING_MAX && !taken {
-            let damped = &hessian + DMatrix::identity(n, n) * (damping * diagonal_scale);
-            let Some(cholesky) = damped.cholesky() else {
+            // The damped Newton step within the free directions; where the damping leaves one of
+            // them without positive curvature, more damping.
+            let shift = damping * diagonal_scale;
+            if free.iter().any(|&k| eigen.eigenvalues[k] + shift <= 0.0) {
                 damping *= DAMPING_FACTOR;
                 continue;
-            };
-            let mut step = -cholesky.solve(&g);
+            }
+            let mut step = DVector::zeros(n);
+            for &k in &free {
+                let direction = eigen.eigenvectors.column(k);
+                step -= direction * (direction.dot(&g) / (eigen.eigenvalues[k] + shift));
+            }
             let length = step.norm();
             if length > settings.max_step {
                 step *= settings.max_step / length;
@@ -100,7 +114,7 @@ pub fn newton_minimise(x0: &[f64], settings: &NewtonSettings, mut eval: impl FnM
 mod tests {
     use super::*;
 
-    const SETTINGS: NewtonSettings = NewtonSettings { iterations: 5, fd_step: 1e-4, max_step: 10.0 };
+    const SETTINGS: NewtonSettings = NewtonSettings { iterations: 5, fd_step: 1e-4, max_step: 10.0, min_curvature_ratio: 0.0 };
 
     /// `0.5 (x - c)^T A (x - c)` with a valley 10^4 times flatter one way than the other, along
     /// a diagonal, where per-parameter steps do worst.
@@ -124,6 +138,21 @@ mod tests {
     }
 
     #[test]
+    fn a_direction_flatter_than_the_floor_is_held_while_the_steep_one_is_solved() {
+        // The valley's flat direction is 10^-4 of the steep one's curvature: under a floor of
+        // 10^-3 it keeps its offset, while the steep offset goes.
+        let held = NewtonSettings { min_curvature_ratio: 1e-3, ..SETTINGS };
+        let offsets = |x: &[f64]| ((x[0] - 1.0 + x[1] - 2.0) / 2f64.sqrt(), (x[0] - 1.0 - (x[1] - 2.0)) / 2f64.sqrt());
+        let start = [-3.0, 5.0];
+        let (x, report) = newton_minimise(&start, &held, valley);
+        let ((p, q), (_, q0)) = (offsets(&x), offsets(&start));
+        assert!(p.abs() < 1e-6 && (q - q0).abs() < 1e-9 && report.taken >= 1, "{x:?} {report:?}");
+        // Under a floor of 10^-5 both are free, and the minimum is reached.
+        let (x, _) = newton_minimise(&start, &NewtonSettings { min_curvature_ratio: 1e-5, ..SETTINGS }, valley);
+        assert!((x[0] - 1.0).hypot(x[1] - 2.0) < 1e-4, "{x:?}");
+    }
+
+    #[test]
     fn rosenbrock_only_ever_goes_down_and_ends_near_its_minimum() {
         let rosenbrock = |x: &[f64]| {
             let (a, b) = (1.0 - x[0], x[1] - x[0] * x[0]);
@@ -142,7 +171,7 @@ mod tests {
 
     #[test]
     fn a_step_is_never_longer_than_the_limit_and_a_flat_objective_is_left_where_it_is() {
-        let settings = NewtonSettings { iterations: 1, fd_step: 1e-3, max_step: 0.5 };
+        let settings = NewtonSettings { iterations: 1, fd_step: 1e-3, max_step: 0.5, min_curvature_ratio: 0.0 };
         let (x, report) = newton_minimise(&[0.0, 0.0], &settings, valley);
         assert!((x[0].hypot(x[1]) - 0.5).abs() < 1e-9 && report.taken == 1, "{x:?}");
         let (x, report) = newton_minimise(&[3.0, -1.0], &SETTINGS, |_| (2.0, vec![0.0, 0.0]));

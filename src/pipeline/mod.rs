@@ -49,6 +49,12 @@ const CUE_HUBER_PX: f32 = 0.1;
 /// Newton steps' Hessian, and their longest step.
 const NEWTON_FD_STEP: f64 = 0.05;
 const NEWTON_MAX_STEP: f64 = 2.0;
+/// The stage-2 Newton steps hold the directions whose curvature is under this share of the
+/// steepest's. On the 256 px suite the two flattest (about 1/300 of the steepest, mostly the
+/// motion prior's own curvature: tilt against vertical translation, pan against sideways
+/// translation) carried the steps that made the slow scenes worse, while the roll and v_z
+/// directions (1/80 and more) carried the gains (docs/results.md).
+const NEWTON_MIN_CURVATURE_RATIO: f64 = 5e-3;
 
 /// Opacity above which a rendered pixel's blended disparity is trusted over the initial map.
 const TRUSTED_ALPHA: f32 = 0.5;
@@ -416,6 +422,7 @@ fn stage2(
             iterations: if s.iterations > 0 { s.newton_iterations } else { 0 },
             fd_step: NEWTON_FD_STEP,
             max_step: NEWTON_MAX_STEP,
+            min_curvature_ratio: NEWTON_MIN_CURVATURE_RATIO,
         },
     };
     // One phase of the fit, with its progress bar and its line in the log. The Newton steps go to
