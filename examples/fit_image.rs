@@ -46,7 +46,7 @@ fn test_image() -> Raster {
 /// Renders `g` as one whole image.
 fn render_image(g: &Gaussians, w: usize, h: usize, settings: &RenderSettings, device: &Device) -> Raster {
     let out = render_rows(g, (0.0, 0.0), w, 0..h, settings, device);
-    let data = out.colour.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
+    let data = rslf::device::host_values(out.colour);
     Raster { width: w, height: h, channels: g.colour.val().dims()[1], data: data.into_iter().map(|x| x.clamp(0.0, 1.0)).collect() }
 }
 

@@ -24,6 +24,11 @@ pub fn device(choice: DeviceChoice) -> crate::Result<Device> {
     }
 }
 
+/// A tensor's values read back to the host, as `f32` in row-major order.
+pub fn host_values<const D: usize>(t: Tensor<D>) -> Vec<f32> {
+    t.into_data().convert::<f32>().try_to_vec::<f32>().expect("float tensor data")
+}
+
 /// Makes and reads back one tensor on `device`; if that panics (here or in the backend's own
 /// threads), the first panic's first line.
 fn probe(device: &Device) -> Result<(), String> {

@@ -13,9 +13,7 @@ use rslf::render::{RenderSettings, RsTiming, StaticShape, render_rolling_shutter
 
 const READOUT: (f64, f64) = (-0.02, 0.02);
 
-fn host<const D: usize>(t: Tensor<D>) -> Vec<f32> {
-    t.into_data().convert::<f32>().try_to_vec::<f32>().unwrap()
-}
+use rslf::device::host_values as host;
 
 fn model(name: &str, segments: usize) -> Box<dyn MotionModel> {
     let config = MotionConfig { model: name.into(), segments };

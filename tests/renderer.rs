@@ -4,6 +4,7 @@
 mod common;
 
 use burn::tensor::{Device, Tensor, TensorData};
+use rslf::device::host_values;
 use rslf::model::{GaussianSet, Gaussians};
 use rslf::render::{PixelBins, RenderOutput, RenderSettings, bins_for_view, render};
 
@@ -45,7 +46,7 @@ fn value(set: &GaussianSet, bins: &PixelBins, device: &Device) -> f64 {
 }
 
 fn grad_vec<const D: usize>(t: Option<Tensor<D>>) -> Vec<f32> {
-    t.expect("gradient present").into_data().convert::<f32>().try_to_vec::<f32>().unwrap()
+    host_values(t.expect("gradient present"))
 }
 
 #[test]
@@ -92,9 +93,9 @@ fn render_values(device: &Device) -> Vec<f32> {
     let settings = RenderSettings::default();
     let bins = bins_for_view(&set, OFFSET, W, 0..H, &settings);
     let out = render(&set.to_module(device), OFFSET, &bins, device);
-    let mut v = out.colour.into_data().convert::<f32>().try_to_vec::<f32>().unwrap();
-    v.extend(out.disparity.into_data().convert::<f32>().try_to_vec::<f32>().unwrap());
-    v.extend(out.alpha.into_data().convert::<f32>().try_to_vec::<f32>().unwrap());
+    let mut v = host_values(out.colour);
+    v.extend(host_values(out.disparity));
+    v.extend(host_values(out.alpha));
     v
 }
 

@@ -119,7 +119,7 @@ mod tests {
         let tc = TensorCamera::new(&cam);
         let device = Device::flex();
         let t = |v: Vec<f32>| Tensor::<1>::from_data(TensorData::new(v.clone(), [v.len()]), &device);
-        let host = |x: Tensor<1>| x.into_data().convert::<f32>().try_to_vec::<f32>().unwrap();
+        let host = crate::device::host_values::<1>;
         let (us, vs, ds) = (vec![10.0f32, 255.5, 400.0], vec![20.0f32, 191.5, 300.0], vec![-1.5f32, 0.0, 2.25]);
         let points = tc.lift(t(us.clone()), t(vs.clone()), t(ds.clone()));
         let view = ViewId { row: 0, col: 8 };

@@ -96,9 +96,7 @@ mod tests {
     use burn::tensor::{Device, TensorData};
     use nalgebra::{Rotation3, Vector3};
 
-    fn values<const D: usize>(t: Tensor<D>) -> Vec<f32> {
-        t.into_data().convert::<f32>().try_to_vec::<f32>().unwrap()
-    }
+    use crate::device::host_values as values;
 
     #[test]
     fn compose_is_the_batched_matrix_product() {

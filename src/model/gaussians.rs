@@ -1,6 +1,7 @@
 //! The scene model of stage 1: N isotropic 2D Gaussians on the central view, five parameters
 //! each (centre u, v; disparity; size; intensity or colour), as a burn `Module`.
 
+use crate::device::host_values;
 use burn::module::{Module, Param};
 use burn::tensor::{Device, Tensor, TensorData};
 
@@ -33,10 +34,6 @@ pub struct GaussianSet {
     pub colour: Vec<f32>,
     /// 1 or 3.
     pub channels: usize,
-}
-
-fn to_vec<const D: usize>(t: Tensor<D>) -> Vec<f32> {
-    t.into_data().convert::<f32>().try_to_vec::<f32>().expect("float tensor data")
 }
 
 impl GaussianSet {
@@ -82,13 +79,13 @@ impl Gaussians {
 
     /// A host copy of the current values.
     pub fn to_set(&self) -> GaussianSet {
-        let centre = to_vec(self.centre.val());
+        let centre = host_values(self.centre.val());
         GaussianSet {
             u: centre.iter().step_by(2).copied().collect(),
             v: centre.iter().skip(1).step_by(2).copied().collect(),
-            disparity: to_vec(self.disparity.val()),
-            size: to_vec(self.log_size.val()).into_iter().map(f32::exp).collect(),
-            colour: to_vec(self.colour.val()),
+            disparity: host_values(self.disparity.val()),
+            size: host_values(self.log_size.val()).into_iter().map(f32::exp).collect(),
+            colour: host_values(self.colour.val()),
             channels: self.channels(),
         }
     }

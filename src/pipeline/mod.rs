@@ -32,6 +32,7 @@ pub use view_tracking::{Track, TrackSettings, textured_points, track};
 pub use visibility::explained_mask;
 
 use crate::config::{Config, TimingChoice, ViewSelection};
+use crate::device::host_values;
 use crate::geometry::{Camera, TensorCamera, ViewId, readout_interval};
 use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::{LossRegistry, WeightedLosses};
@@ -147,18 +148,16 @@ pub fn rs_timing(config: &Config) -> RsTiming {
 /// Colour and opacity-normalised disparity of a whole-image render; the disparity is
 /// `fallback`'s where the render is not opaque enough.
 fn central_rasters(out: RenderOutput, w: usize, h: usize, c: usize, fallback: &Raster) -> (Raster, Raster) {
-    let data = |t: TensorData| t.convert::<f32>().try_to_vec::<f32>().expect("float data");
     let colour = colour_raster(out.colour, w, h, c);
-    let disparity = data(out.disparity.into_data());
-    let alpha = data(out.alpha.into_data());
+    let disparity = host_values(out.disparity);
+    let alpha = host_values(out.alpha);
     let disparity = (0..w * h).map(|i| if alpha[i] > TRUSTED_ALPHA { disparity[i] / alpha[i] } else { fallback.data[i] }).collect();
     (colour, Raster { width: w, height: h, channels: 1, data: disparity })
 }
 
 /// The `[P, C]` colour of a whole-view render as a `w x h` image with `c` channels.
 fn colour_raster(colour: Tensor<2>, w: usize, h: usize, c: usize) -> Raster {
-    let data = colour.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
-    Raster { width: w, height: h, channels: c, data }
+    Raster { width: w, height: h, channels: c, data: host_values(colour) }
 }
 
 /// Renders the central view of `g`: its colour, and its disparity where opaque enough

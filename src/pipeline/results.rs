@@ -39,9 +39,8 @@ pub struct PointCloud {
 impl PointCloud {
     /// The centres and colours of a static shape; points behind the camera are left out.
     pub fn of_shape(shape: &StaticShape) -> Self {
-        let host = |t: burn::tensor::TensorData| t.convert::<f32>().try_to_vec::<f32>().expect("float data");
-        let p = host(shape.points.clone().into_data());
-        let c = host(shape.colour.clone().into_data());
+        let p = crate::device::host_values(shape.points.clone());
+        let c = crate::device::host_values(shape.colour.clone());
         let channels = shape.colour.dims()[1];
         let mut cloud = Self { positions: Vec::new(), colours: Vec::new() };
         for (xyz, col) in p.chunks_exact(3).zip(c.chunks_exact(channels)) {

@@ -7,6 +7,7 @@ use super::cue_term::CueTerm;
 use super::stage1_fit::{LearningRates, with_gaussian_groups};
 use super::targets::{ViewTarget, band_tensor, view_targets};
 use super::visibility::{explained_mask_moving, masked};
+use crate::device::host_values;
 use crate::geometry::{Camera, TensorCamera, ViewId};
 use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
@@ -293,8 +294,7 @@ pub fn fit_stage2(
             let add = |total: &mut (f64, Vec<f64>), term: Tensor<1>, scaled: Tensor<1>| {
                 total.0 += term.clone().into_scalar::<f32>() as f64;
                 if let Some(g) = scaled.grad(&term.backward()) {
-                    let g = g.into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
-                    total.1.iter_mut().zip(g).for_each(|(a, b)| *a += b as f64);
+                    total.1.iter_mut().zip(host_values(g)).for_each(|(a, b)| *a += b as f64);
                 }
             };
             let mut photometric = (0.0, vec![0.0; n]);

@@ -75,7 +75,7 @@ impl Splats {
 
     /// The bins of `rows` of a `width`-pixel-wide view for these splats (read back to the host).
     pub fn bins(&self, width: usize, rows: Range<usize>, settings: &RenderSettings) -> PixelBins {
-        let host = |t: &Tensor<1>| t.clone().into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
+        let host = |t: &Tensor<1>| crate::device::host_values(t.clone());
         bin(&host(&self.u), &host(&self.v), &host(&self.disparity), &host(&self.sigma), width, rows, settings)
     }
 }

@@ -103,7 +103,7 @@ impl MotionParams {
 
     /// The SI parameter vector on the host.
     pub fn si_values(&self, scales: &[f64]) -> Vec<f64> {
-        let v = self.scaled.val().into_data().convert::<f32>().try_to_vec::<f32>().expect("float data");
+        let v = crate::device::host_values(self.scaled.val());
         v.iter().zip(scales).map(|(&x, s)| x as f64 * s).collect()
     }
 }
