@@ -116,11 +116,17 @@ mod tests {
 
     const SETTINGS: NewtonSettings = NewtonSettings { iterations: 5, fd_step: 1e-4, max_step: 10.0, min_curvature_ratio: 0.0 };
 
+    /// The offsets of `x` from the valley's minimum (1, 2) along its steep and its flat
+    /// direction.
+    fn offsets(x: &[f64]) -> (f64, f64) {
+        ((x[0] - 1.0 + x[1] - 2.0) / 2f64.sqrt(), (x[0] - 1.0 - (x[1] - 2.0)) / 2f64.sqrt())
+    }
+
     /// `0.5 (x - c)^T A (x - c)` with a valley 10^4 times flatter one way than the other, along
     /// a diagonal, where per-parameter steps do worst.
     fn valley(x: &[f64]) -> (f64, Vec<f64>) {
         let (a, b) = (1.0, 1e-4);
-        let (p, q) = ((x[0] - 1.0 + x[1] - 2.0) / 2f64.sqrt(), (x[0] - 1.0 - (x[1] - 2.0)) / 2f64.sqrt());
+        let (p, q) = offsets(x);
         let f = 0.5 * (a * p * p + b * q * q);
         let (dp, dq) = (a * p, b * q);
         (f, vec![(dp + dq) / 2f64.sqrt(), (dp - dq) / 2f64.sqrt()])
@@ -142,7 +148,6 @@ mod tests {
         // The valley's flat direction is 10^-4 of the steep one's curvature: under a floor of
         // 10^-3 it keeps its offset, while the steep offset goes.
         let held = NewtonSettings { min_curvature_ratio: 1e-3, ..SETTINGS };
-        let offsets = |x: &[f64]| ((x[0] - 1.0 + x[1] - 2.0) / 2f64.sqrt(), (x[0] - 1.0 - (x[1] - 2.0)) / 2f64.sqrt());
         let start = [-3.0, 5.0];
         let (x, report) = newton_minimise(&start, &held, valley);
         let ((p, q), (_, q0)) = (offsets(&x), offsets(&start));
