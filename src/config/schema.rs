@@ -211,11 +211,12 @@ pub struct Stage2Config {
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
     pub initial_motion: Option<PathBuf>,
-    /// Damped Newton steps on the motion after each Adam fit (0 = none): the objective's
-    /// Hessian in the motion parameters from finite differences of its gradient over every band
-    /// of the compared views, each step taken only where it lowers that objective. They reach
-    /// along the nearly flat directions (roll, zoom, rotation against translation) that Adam's
-    /// decaying steps leave short.
+    /// Damped Newton steps on the motion after the Adam steps of the fit whose motion is kept
+    /// (0 = none): the objective's Hessian in the motion parameters from finite differences of
+    /// its gradient over every band of the compared views, each step taken only where it lowers
+    /// that objective. They reach along the nearly flat directions (roll, forward translation)
+    /// that Adam's decaying steps leave short, and hold the flattest (rotation against
+    /// translation), which the views hardly observe.
     pub newton_iterations: usize,
 }
 

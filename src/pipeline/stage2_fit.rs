@@ -321,7 +321,7 @@ pub fn fit_stage2(
             progress(fit.iterations + evaluations, fit.iterations, total.0 as f32);
             total
         };
-        let start: Vec<f64> = adam.iter().zip(&scales).map(|(p, s)| p / s).collect();
+        let start: Vec<f64> = host_values(fitted.motion.scaled.val()).into_iter().map(f64::from).collect();
         let (end, report) = newton_minimise(&start, &fit.newton, eval);
         (end.iter().zip(&scales).map(|(x, s)| x * s).collect(), Some(report))
     } else {
