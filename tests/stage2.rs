@@ -229,3 +229,27 @@ fn newton_steps_after_a_short_adam_fit_lower_its_objective_over_every_band_and_l
     assert!(taken >= 1 && after <= before, "{line}");
     assert!(newton < 0.85 * adam, "image-space error: Adam alone {adam:.3} px, then Newton {newton:.3} px");
 }
+
+#[test]
+fn with_the_measured_cues_the_newton_steps_leave_the_motion_prior_out() {
+    // Adam's rate 0 holds the motion at rest, so runs that differ only in the prior's weight
+    // reach the Newton steps with the same Gaussians and motion. With the cue term in the
+    // objective the steps must not see the prior (same motion at weights 3e-5 and 1); with the
+    // photometric terms alone they keep it (a prior of 1 holds the motion nearer rest).
+    let root = common::tempdir();
+    generate(root.path());
+    let run = |name: &str, cue_weight: f64, prior: f64| {
+        let extra = format!(
+            "iterations = 10\nlr = 0.0\nlr_final = 0.0\nmin_cue_support = 0.0\ncue_weight = {cue_weight:?}\nnewton_iterations = 3\n\
+             [[loss]]\nkind = \"l1\"\nweight = 1.0\n[[loss]]\nkind = \"motion_prior\"\nweight = {prior:?}"
+        );
+        let stdout = train(root.path(), &config(root.path(), name, "constant_velocity", &extra), name);
+        assert!(stdout.contains("Newton steps taken"), "{stdout}");
+        MotionRecord::read(&root.path().join(name).join("motion.toml")).unwrap()
+    };
+    let (weak, strong) = (run("cues_weak_prior", 1.0, 3e-5), run("cues_strong_prior", 1.0, 1.0));
+    assert!(weak != MotionRecord::zero(), "the steps did not move: {weak:?}");
+    assert_eq!(weak, strong);
+    let (weak, strong) = (run("weak_prior", 0.0, 3e-5), run("strong_prior", 0.0, 1.0));
+    assert!(weak != strong, "{weak:?}");
+}

@@ -216,7 +216,8 @@ pub struct Stage2Config {
     /// its gradient over every band of the compared views, each step taken only where it lowers
     /// that objective. They reach along the nearly flat directions (roll, forward translation)
     /// that Adam's decaying steps leave short, and hold the flattest (rotation against
-    /// translation), which the views hardly observe.
+    /// translation), which the views hardly observe. With the measured cues in the objective
+    /// they leave the motion prior out: it would only shrink the directions they move.
     pub newton_iterations: usize,
 }
 

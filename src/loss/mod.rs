@@ -36,7 +36,8 @@ pub struct LossInput<'a> {
     /// Pixels per row.
     pub width: usize,
     /// The motion parameters being fitted, scaled so that one unit moves the image by about one
-    /// pixel over the read-out (`None` in stages without motion).
+    /// pixel over the read-out (`None` in stages without motion, and in stage 2's Newton steps
+    /// when the measured cues are in their objective).
     pub motion: Option<&'a Tensor<1>>,
 }
 

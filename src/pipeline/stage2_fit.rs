@@ -278,8 +278,11 @@ pub fn fit_stage2(
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
     let adam = fitted.motion.si_values(&scales);
     // Newton steps on the motion alone (Gaussians held), over every band of every view: the
-    // objective the motion's Adam steps sample. Each evaluation is reported as a step beyond
-    // Adam's last.
+    // objective the motion's Adam steps sample, less the motion prior when the measured cues are
+    // in it. The steps hold the directions the views barely observe where Adam left them (their
+    // curvature is under the floor); along the ones they move, the cues constrain the motion and
+    // the prior would only shrink it towards rest, while the photometric terms alone still need
+    // it (docs/results.md). Each evaluation is reported as a step beyond Adam's last.
     let (parameters, newton) = if fit.newton.iterations > 0 {
         let held = fitted.gaussians.clone().no_grad();
         let n = scales.len();
@@ -302,7 +305,8 @@ pub fn fit_stage2(
             for v in 0..targets.len() {
                 let scaled = leaf();
                 let params = MotionParams::to_si(scaled.clone(), &scales);
-                let pass = Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params, weighted: true, prior: true };
+                let pass =
+                    Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params, weighted: true, prior: cues.is_none() };
                 let part = compare(&pass, None, masks, &scaled, &mut |u| if u == v { every.clone() } else { Vec::new() });
                 bands += part.count();
                 if let Some(sum) = part.sum() {
