@@ -42,6 +42,11 @@ fn config(dir: &Path, name: &str, model: &str, extra: &str) -> String {
     path.to_str().unwrap().to_string()
 }
 
+/// The motion a run wrote to `dir/out`.
+fn motion_of(dir: &Path, out: &str) -> MotionRecord {
+    MotionRecord::read(&dir.join(out).join("motion.toml")).unwrap()
+}
+
 fn train(dir: &Path, config: &str, out: &str) -> String {
     let out = dir.join(out);
     let (ok, stdout, stderr) = rslf(&["train", config, "--out", out.to_str().unwrap(), "--models", dir.join("models").to_str().unwrap()]);
@@ -81,7 +86,7 @@ fn each_motion_model_runs_by_config_and_writes_format_results() {
         }
         assert_eq!(stdout.contains("weighted by their horizontal gradient share"), weighted, "{stdout}");
         let out = root.path().join(model);
-        let motion = MotionRecord::read(&out.join("motion.toml")).unwrap();
+        let motion = motion_of(root.path(), model);
         assert_eq!(motion.model_name(), model);
         let curve = std::fs::read_to_string(out.join("loss_stage2.csv")).unwrap();
         assert_eq!(curve.lines().count(), 11, "{curve}");
@@ -139,7 +144,7 @@ fn aperture_weighting_reaches_the_motion_only_the_joint_refinement_sees_every_pi
     let run = |name: &str, extra: &str| {
         train(root.path(), &config(root.path(), name, "constant_velocity", &format!("iterations = 10\n{extra}")), name);
         let disparity = rslf::io::read_pfm(&root.path().join(name).join("disparity.pfm")).unwrap();
-        (disparity, MotionRecord::read(&root.path().join(name).join("motion.toml")).unwrap())
+        (disparity, motion_of(root.path(), name))
     };
     let held = "lr = 0.0\nlr_final = 0.0";
     let (plain, _) = run("held", held);
@@ -167,9 +172,7 @@ fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
     let run = |root: &Path, name: &str, min_support: f64| {
         let extra = format!("iterations = 10\ncue_weight = 1.0\nmin_cue_support = {min_support:?}");
         let stdout = train(root, &config(root, name, "constant_velocity", &extra), name);
-        let out = root.join(name);
-        let motion = MotionRecord::read(&out.join("motion.toml")).unwrap();
-        (stdout, out, motion)
+        (stdout, root.join(name), motion_of(root, name))
     };
     for (root, kept) in [(turning.path(), true), (still.path(), false)] {
         let (stdout, out, motion) = run(root, "checked", 0.5);
@@ -245,7 +248,7 @@ fn with_the_measured_cues_the_newton_steps_leave_the_motion_prior_out() {
         );
         let stdout = train(root.path(), &config(root.path(), name, "constant_velocity", &extra), name);
         assert!(stdout.contains("Newton steps taken"), "{stdout}");
-        MotionRecord::read(&root.path().join(name).join("motion.toml")).unwrap()
+        motion_of(root.path(), name)
     };
     let (weak, strong) = (run("cues_weak_prior", 1.0, 3e-5), run("cues_strong_prior", 1.0, 1.0));
     assert!(weak != MotionRecord::zero(), "the steps did not move: {weak:?}");
