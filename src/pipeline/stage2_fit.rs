@@ -276,7 +276,6 @@ pub fn fit_stage2(
         }
     };
     let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
-    let adam = fitted.motion.si_values(&scales);
     // Newton steps on the motion alone (Gaussians held), over every band of every view: the
     // objective the motion's Adam steps sample, less the motion prior when the measured cues are
     // in it. The steps hold the directions the views barely observe where Adam left them (their
@@ -329,7 +328,7 @@ pub fn fit_stage2(
         let (end, report) = newton_minimise(&start, &fit.newton, eval);
         (end.iter().zip(&scales).map(|(x, s)| x * s).collect(), Some(report))
     } else {
-        (adam, None)
+        (fitted.motion.si_values(&scales), None)
     };
     let kept = masks.map_or(1.0, |(kept, _)| kept);
     MotionFit { parameters, scales, curve, gaussians: fitted.gaussians, kept, newton }
