@@ -248,6 +248,8 @@ fn with_the_measured_cues_the_newton_steps_leave_the_motion_prior_out() {
         );
         let stdout = train(root.path(), &config(root.path(), name, "constant_velocity", &extra), name);
         assert!(stdout.contains("Newton steps taken"), "{stdout}");
+        // The log says whose objective the steps minimised.
+        assert_eq!(stdout.contains("leaves the motion prior out"), cue_weight > 0.0, "{stdout}");
         motion_of(root.path(), name)
     };
     let (weak, strong) = (run("cues_weak_prior", 1.0, 3e-5), run("cues_strong_prior", 1.0, 1.0));

@@ -471,8 +471,13 @@ fn stage2(
             fitted.curve.first().copied().unwrap_or(f32::NAN),
             fitted.curve.last().copied().unwrap_or(f32::NAN),
             fitted.newton.map_or(String::new(), |r| format!(
-                ", then {} of {} Newton steps taken over every band, {:.5} -> {:.5} ({} evaluations)",
-                r.taken, s.newton_iterations, r.start, r.end, r.evaluations
+                ", then {} of {} Newton steps taken over every band{}, {:.5} -> {:.5} ({} evaluations)",
+                r.taken,
+                s.newton_iterations,
+                if cue_term.is_some() { " (their objective leaves the motion prior out)" } else { "" },
+                r.start,
+                r.end,
+                r.evaluations
             )),
             start.elapsed().as_secs_f64()
         ));
