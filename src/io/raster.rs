@@ -26,6 +26,12 @@ impl Raster {
         Self { width, height, channels: 1, data: (0..width * height).map(|i| f(i % width, i / width)).collect() }
     }
 
+    /// `from_fn` for tests written in f64: pixel (x, y) is `f(x, y)` at its integer coordinates.
+    #[cfg(test)]
+    pub(crate) fn from_f64_fn(width: usize, height: usize, f: impl Fn(f64, f64) -> f64) -> Self {
+        Self::from_fn(width, height, |x, y| f(x as f64, y as f64) as f32)
+    }
+
     /// Wraps `data`; `None` when its length does not match the size.
     pub fn from_vec(width: usize, height: usize, channels: usize, data: Vec<f32>) -> Option<Self> {
         (data.len() == width * height * channels).then_some(Self { width, height, channels, data })

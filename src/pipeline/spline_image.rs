@@ -122,13 +122,9 @@ fn prefilter(c: &mut [f64]) {
 mod tests {
     use super::*;
 
-    fn raster(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Raster {
-        Raster::from_fn(w, h, |x, y| f(x as f64, y as f64) as f32)
-    }
-
     #[test]
     fn the_spline_passes_through_every_sample() {
-        let image = raster(23, 17, |x, y| ((0.9 * x + 0.4 * y).sin() + (1.3 * y - 0.7 * x).cos()) * 0.25 + 0.5);
+        let image = Raster::from_f64_fn(23, 17, |x, y| ((0.9 * x + 0.4 * y).sin() + (1.3 * y - 0.7 * x).cos()) * 0.25 + 0.5);
         let spline = SplineImage::new(&image);
         for y in 0..17 {
             for x in 0..23 {
@@ -144,7 +140,7 @@ mod tests {
         // cos(ω x) sampled at integers, interpolated at fractions of a pixel: the phase error of
         // bilinear interpolation is about f (1 - 3f) ω²/6, 0.012 px at f = 0.1 and ω = 1.
         let omega = 1.0;
-        let image = raster(64, 8, |x, _| (omega * x).cos());
+        let image = Raster::from_f64_fn(64, 8, |x, _| (omega * x).cos());
         let spline = SplineImage::new(&image);
         for f in [0.05, 0.1, 0.2, 0.3, 0.5, 0.8] {
             // The least-squares fit A cos(ω x) + B sin(ω x) over the middle of the row: the

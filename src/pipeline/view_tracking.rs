@@ -156,18 +156,13 @@ pub fn track_warped(
 mod tests {
     use super::*;
 
-    /// A grey `w` x `h` image whose pixel (x, y) is `f(x, y)`.
-    fn image(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Raster {
-        Raster::from_fn(w, h, |x, y| f(x as f64, y as f64) as f32)
-    }
-
     /// A smooth 2D texture shifted by (sx, sy): the value at (x, y) is the texture's at (x - sx, y - sy).
     fn texture(w: usize, h: usize, sx: f64, sy: f64) -> Raster {
         // Wavelengths of 25-50 px.
         let f = |x: f64, y: f64| {
             0.5 + 0.2 * (0.21 * x + 0.13 * y).sin() + 0.2 * (0.17 * y - 0.09 * x).cos() + 0.1 * (0.12 * x + 0.19 * y).sin()
         };
-        image(w, h, |x, y| f(x - sx, y - sy))
+        Raster::from_f64_fn(w, h, |x, y| f(x - sx, y - sy))
     }
 
     #[test]
@@ -183,7 +178,9 @@ mod tests {
     fn a_small_fraction_of_a_pixel_on_a_fine_texture_is_not_overshot() {
         // Texture near 1 rad/px moved 0.1 px sideways, a rolling-shutter cue's size: bilinear
         // resampling would find it about 0.012 px too far, the same way for every patch.
-        let fine = |sx: f64| image(48, 48, |x, y| 0.5 + 0.2 * (1.1 * (x - sx) + 0.3 * y).sin() + 0.2 * (0.9 * y - 0.8 * (x - sx)).cos());
+        let fine = |sx: f64| {
+            Raster::from_f64_fn(48, 48, |x, y| 0.5 + 0.2 * (1.1 * (x - sx) + 0.3 * y).sin() + 0.2 * (0.9 * y - 0.8 * (x - sx)).cos())
+        };
         for shift in [0.05, 0.1, -0.1, 0.2] {
             let t = track(&fine(0.0), &SplineImage::new(&fine(shift)), (24, 24), (0.0, 0.0), &TrackSettings::default()).unwrap();
             assert!((t.displacement.0 - shift).abs() < 2.5e-3 && t.displacement.1.abs() < 2.5e-3, "{shift}: {t:?}");
@@ -197,8 +194,8 @@ mod tests {
         // floor between a row view and a corner.
         let (c, stretch, shift) = (32.0, 0.08, (0.4, -2.3));
         let f = |x: f64, y: f64| 0.5 + (0.05 + 0.02 * (y - c).max(-2.5)) * ((0.9 * x + 0.4 * y).sin() + (1.1 * y - 0.3 * x).cos());
-        let from = image(64, 64, f);
-        let to = SplineImage::new(&image(64, 64, |x, y| f(x - shift.0, c + (y - c - shift.1) / (1.0 + stretch))));
+        let from = Raster::from_f64_fn(64, 64, f);
+        let to = SplineImage::new(&Raster::from_f64_fn(64, 64, |x, y| f(x - shift.0, c + (y - c - shift.1) / (1.0 + stretch))));
         let settings = TrackSettings::default();
         let plain = track(&from, &to, (32, 32), (0.0, -2.0), &settings).unwrap().displacement;
         let warped = track_warped(&from, &to, (32, 32), (0.0, -2.0), [[0.0, 0.0], [0.0, stretch]], &settings).unwrap().displacement;
@@ -220,7 +217,7 @@ mod tests {
                 if ((u / 3.3).floor() + (v / 2.7).floor()) as i64 % 2 == 0 { 0.8 } else { 0.2 }
             };
             let samples = [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)];
-            image(64, 64, |x, y| samples.iter().map(|(dx, dy)| cell(x - sx + dx, y - sy + dy)).sum::<f64>() / 4.0)
+            Raster::from_f64_fn(64, 64, |x, y| samples.iter().map(|(dx, dy)| cell(x - sx + dx, y - sy + dy)).sum::<f64>() / 4.0)
         };
         let from = render(0.0, 0.0);
         for shift in [(0.0, 0.1), (0.0, 0.4), (0.0, 2.6), (0.0, -4.8), (0.25, 0.0), (-1.3, 0.0), (7.6, 0.0)] {
@@ -245,7 +242,7 @@ mod tests {
     #[test]
     fn a_stripe_pins_one_direction_only_and_is_not_chosen() {
         // Vertical stripes: no vertical texture.
-        let stripes = image(48, 48, |x, _| 0.5 + 0.4 * (x * 0.5).sin());
+        let stripes = Raster::from_f64_fn(48, 48, |x, _| 0.5 + 0.4 * (x * 0.5).sin());
         assert!(textured_points(&stripes, 4, 4, 0.1).is_empty());
         assert!(track(&stripes, &SplineImage::new(&stripes), (24, 24), (0.0, 0.0), &TrackSettings::default()).is_none());
         let tex = texture(48, 48, 0.0, 0.0);
