@@ -3,8 +3,8 @@
 
 use super::scene_folder::{GenerateOptions, generate_with_progress};
 use super::suite::{SuiteEntry, suite};
-use crate::io::{IoError, IoResult};
-use std::path::PathBuf;
+use crate::io::{IoError, IoResult, write_atomic};
+use std::path::{Path, PathBuf};
 
 /// The prefix that marks a built-in scene in a config's `scene`.
 pub const BUILTIN_PREFIX: &str = "builtin:";
@@ -32,11 +32,6 @@ pub fn builtin_scene(name: &str) -> IoResult<PathBuf> {
 /// generated when not yet in the cache. The suite's motions are set for 512 px and their pixel
 /// shifts scale with the width (a 64 px scene moves 1/8 as many pixels).
 pub fn builtin_scene_sized(name: &str, size: Option<[usize; 2]>) -> IoResult<PathBuf> {
-    // A cached scene is returned without building the suite.
-    let dir = cache_folder(name, size);
-    if dir.join("parameters.cfg").exists() {
-        return Ok(dir);
-    }
     let options = GenerateOptions { size, ..GenerateOptions::default() };
     let entries = suite(&options)?;
     let entry = entries.iter().find(|e| e.name == name).ok_or_else(|| {
@@ -47,23 +42,67 @@ pub fn builtin_scene_sized(name: &str, size: Option<[usize; 2]>) -> IoResult<Pat
 }
 
 /// The cache folder of suite entry `entry` generated under `options` (the entry must come from
-/// `suite(options)`), generated when not yet there.
+/// `suite(options)`), generated when not yet there or when the folder there was generated from
+/// anything else (an older rslf's descriptions, another seed).
 pub fn cached_suite_scene(entry: &SuiteEntry, options: &GenerateOptions) -> IoResult<PathBuf> {
-    let dir = cache_folder(&entry.name, options.size);
-    if dir.join("parameters.cfg").exists() {
+    cached_in(&cache_dir().join("scenes"), entry, options)
+}
+
+/// The file of a cached scene that holds what it was generated from.
+const GENERATED_FROM: &str = "generated_from.toml";
+
+fn cached_in(root: &Path, entry: &SuiteEntry, options: &GenerateOptions) -> IoResult<PathBuf> {
+    let dir = root.join(match options.size {
+        Some([w, h]) => format!("{}_{w}x{h}", entry.name),
+        None => entry.name.clone(),
+    });
+    let stamp = generated_from(entry, options).map_err(|e| IoError::new(&dir, e))?;
+    let cached = std::fs::read_to_string(dir.join(GENERATED_FROM)).ok();
+    if dir.join("parameters.cfg").exists() && cached.as_deref() == Some(stamp.as_str()) {
         return Ok(dir);
     }
-    println!("generating built-in scene {} into {} (once)", entry.name, dir.display());
+    let why = if dir.exists() { "its description changed" } else { "once" };
+    println!("generating built-in scene {} into {} ({why})", entry.name, dir.display());
     let scene = generate_with_progress(&entry.description, options).map_err(|e| IoError::new(&dir, e))?;
     scene.write(&dir, true)?;
+    // Written last: a folder without it (an interrupted run) is generated again.
+    write_atomic(&dir.join(GENERATED_FROM), stamp.as_bytes())?;
     Ok(dir)
 }
 
-/// Where suite scene `name` at `size` is cached.
-fn cache_folder(name: &str, size: Option<[usize; 2]>) -> PathBuf {
-    let folder = match size {
-        Some([w, h]) => format!("{name}_{w}x{h}"),
-        None => name.to_string(),
-    };
-    cache_dir().join("scenes").join(folder)
+/// What a cached scene is generated from: its scene description (`rslf generate`'s input) and
+/// the options, in a comment.
+fn generated_from(entry: &SuiteEntry, options: &GenerateOptions) -> Result<String, String> {
+    let description = toml::to_string(&entry.description).map_err(|e| format!("the description of {}: {e}", entry.name))?;
+    let size = options.size.map_or("the description's".to_string(), |[w, h]| format!("{w}x{h}"));
+    Ok(format!("# suite scene {}, generated at size {size}, seed {}\n{description}", entry.name, options.seed))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synth::SceneDescription;
+
+    #[test]
+    fn a_cached_scene_is_generated_again_only_when_what_it_was_generated_from_changed() {
+        let root = std::env::temp_dir().join(format!("rslf-cache-test-{}", std::process::id()));
+        let options = GenerateOptions { size: Some([12, 12]), ..GenerateOptions::default() };
+        let entries = suite(&options).unwrap();
+        let entry = &entries[0];
+        let dir = cached_in(&root, entry, &options).unwrap();
+        assert!(dir.join("parameters.cfg").exists());
+        let stamp = std::fs::read_to_string(dir.join(GENERATED_FROM)).unwrap();
+        // What rslf generate reads: the same description back.
+        assert_eq!(SceneDescription::parse(&stamp, Path::new(GENERATED_FROM)).unwrap(), entry.description);
+        // Same description: the folder is kept (a marker put in it survives).
+        std::fs::write(dir.join("marker"), "").unwrap();
+        cached_in(&root, entry, &options).unwrap();
+        assert!(dir.join("marker").exists());
+        // Another one (an older rslf's, or no record of it): generated again.
+        std::fs::write(dir.join(GENERATED_FROM), stamp.replace("supersampling", "# supersampling")).unwrap();
+        cached_in(&root, entry, &options).unwrap();
+        assert!(!dir.join("marker").exists());
+        assert_eq!(std::fs::read_to_string(dir.join(GENERATED_FROM)).unwrap(), stamp);
+        std::fs::remove_dir_all(&root).unwrap();
+    }
 }
