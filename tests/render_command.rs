@@ -10,8 +10,7 @@ use std::path::Path;
 
 /// A 64x64 version of `configs/scenes/objects.toml` (rolling shutter, zero motion).
 fn generate(dir: &Path) -> String {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml")).unwrap();
-    let text = text.replace("size = [512, 512]", "size = [64, 64]").replace("supersampling = 2", "supersampling = 1");
+    let text = common::small_objects_description();
     let description = dir.join("static.toml");
     std::fs::write(&description, text).unwrap();
     let scene = dir.join("scene");

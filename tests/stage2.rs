@@ -16,8 +16,7 @@ fn generate(dir: &Path) {
 
 /// The same scene turning at `omega_y` rad/s about Y.
 fn generate_turning(dir: &Path, omega_y: f64) {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml")).unwrap();
-    let text = text.replace("size = [512, 512]", "size = [64, 64]").replace("supersampling = 2", "supersampling = 1");
+    let text = common::small_objects_description();
     let description = dir.join("moving.toml");
     std::fs::write(
         &description,

@@ -147,3 +147,16 @@ pub fn warp_error(scene: &Scene, disparity: &Raster, view: ViewId, sign: f64, bo
     }
     sum / n as f64
 }
+
+/// `configs/scenes/objects.toml` at 64 x 64 px and one ray per pixel: small and quick to render.
+pub fn small_objects_description() -> String {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml")).unwrap();
+    let small = |line: &str| match line {
+        l if l.starts_with("size = ") => "size = [64, 64]".to_string(),
+        l if l.starts_with("supersampling = ") => "supersampling = 1".to_string(),
+        l => l.to_string(),
+    };
+    let text: Vec<String> = text.lines().map(small).collect();
+    assert!(text.iter().any(|l| l == "size = [64, 64]") && text.iter().any(|l| l == "supersampling = 1"));
+    text.join("\n") + "\n"
+}
