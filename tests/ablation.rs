@@ -18,6 +18,8 @@ fn the_ablation_prints_and_writes_the_four_row_table() {
     );
     assert!(ok, "{stderr}");
     assert!(stdout.contains("ablation: 3 scenes x 4 variants at 32x32 px"), "{stdout}");
+    // The cue check's verdict under each run that fits a motion (3 scenes x 2 variants).
+    assert_eq!(stdout.matches(" check: ").count(), 6, "{stdout}");
     let table = std::fs::read_to_string(out.join("ablation.md")).unwrap();
     assert!(stdout.contains(&table), "the printed table is the written one");
     let rows: Vec<&str> = table.lines().skip(2).take(4).collect();

@@ -82,7 +82,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
                 config.stage2.iterations = 0;
             }
             let start = Instant::now();
-            let (result, _) = pipeline::run_with(&config, &scene, &device, &registries)?;
+            let (result, log) = pipeline::run_with(&config, &scene, &device, &registries)?;
             let out = args.out.join(&entry.name).join(variant.replace(", ", "_").replace(' ', "_"));
             result.write(&out, scene.camera().as_ref())?;
             let report = evaluate(&scene_dir, &out)?;
@@ -106,6 +106,11 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
                 motion_error_px.map_or(String::new(), |e| format!("  motion {e:.2} px")),
                 seconds
             );
+            // The cue check's verdict where stage 2 ran: a drift it kept on a still scene shows
+            // here by name, not only as a motion error.
+            if let Some(check) = log.lines.iter().find_map(|l| l.strip_prefix("stage 2 check: ")) {
+                println!("  {:24} {:20} check: {check}", "", "");
+            }
             rows.push(Row {
                 scene: entry.name.clone(),
                 category: entry.category,
