@@ -84,25 +84,26 @@ mod tests {
     use crate::synth::SceneDescription;
 
     #[test]
-    fn a_cached_scene_is_generated_again_only_when_what_it_was_generated_from_changed() {
+    fn a_cached_scene_is_generated_again_only_when_what_it_was_generated_from_changed() -> Result<(), Box<dyn std::error::Error>> {
         let root = std::env::temp_dir().join(format!("rslf-cache-test-{}", std::process::id()));
         let options = GenerateOptions { size: Some([12, 12]), ..GenerateOptions::default() };
-        let entries = suite(&options).unwrap();
+        let entries = suite(&options)?;
         let entry = &entries[0];
-        let dir = cached_in(&root, entry, &options).unwrap();
+        let dir = cached_in(&root, entry, &options)?;
         assert!(dir.join("parameters.cfg").exists());
-        let stamp = std::fs::read_to_string(dir.join(GENERATED_FROM)).unwrap();
+        let stamp = std::fs::read_to_string(dir.join(GENERATED_FROM))?;
         // What rslf generate reads: the same description back.
-        assert_eq!(SceneDescription::parse(&stamp, Path::new(GENERATED_FROM)).unwrap(), entry.description);
+        assert_eq!(SceneDescription::parse(&stamp, Path::new(GENERATED_FROM))?, entry.description);
         // Same description: the folder is kept (a marker put in it survives).
-        std::fs::write(dir.join("marker"), "").unwrap();
-        cached_in(&root, entry, &options).unwrap();
+        std::fs::write(dir.join("marker"), "")?;
+        cached_in(&root, entry, &options)?;
         assert!(dir.join("marker").exists());
         // Another one (an older rslf's, or no record of it): generated again.
-        std::fs::write(dir.join(GENERATED_FROM), stamp.replace("supersampling", "# supersampling")).unwrap();
-        cached_in(&root, entry, &options).unwrap();
+        std::fs::write(dir.join(GENERATED_FROM), stamp.replace("supersampling", "# supersampling"))?;
+        cached_in(&root, entry, &options)?;
         assert!(!dir.join("marker").exists());
-        assert_eq!(std::fs::read_to_string(dir.join(GENERATED_FROM)).unwrap(), stamp);
-        std::fs::remove_dir_all(&root).unwrap();
+        assert_eq!(std::fs::read_to_string(dir.join(GENERATED_FROM))?, stamp);
+        std::fs::remove_dir_all(&root)?;
+        Ok(())
     }
 }
