@@ -193,8 +193,9 @@ pub struct Stage2Config {
     /// Weight of the measured-cue term (0 = off): textured patches of the central-row view of
     /// the column of each view in `cue_views` are tracked into the view of the central row
     /// farthest from it (their disparity) and into that view, which measures, with no scene
-    /// model, how far the motion moved each from where its disparity alone puts it; the term is
-    /// the mean Huber penalty (px) of the motion's predicted cues against those. With the cue
+    /// model, how far the motion moved each from where its disparity alone puts it (across the
+    /// edges only, for an edge or a stripe); the term is the Huber penalty (px) of the motion's
+    /// predicted cues against those along each measured direction, averaged per cue. With the cue
     /// check on, the term is left out of the fit the check judges, and a motion the check
     /// confirms is fitted again from the start with it.
     pub cue_weight: f64,
@@ -208,6 +209,11 @@ pub struct Stage2Config {
     /// the central row and the central column, each tracked from the central-row view of its
     /// column).
     pub cue_views: ViewSelection,
+    /// Edges and stripes (patches textured one way) give cues too: the component of the cue
+    /// across them. They reach rows that patches textured both ways leave without cues (a
+    /// striped wall), which a model with rates per part of the read-out needs; they carry
+    /// biases of a few percent of the cue that the two-way patches do not (docs/results.md).
+    pub cue_edges: bool,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
     pub initial_motion: Option<PathBuf>,
@@ -240,6 +246,7 @@ impl Default for Stage2Config {
             cue_weight: 1.0,
             min_cue_support: 0.5,
             cue_views: ViewSelection::Corners,
+            cue_edges: true,
             initial_motion: None,
             newton_iterations: 5,
         }

@@ -9,9 +9,10 @@
 //! Stage 2 keeps a motion only when its support is clearly over a threshold
 //! ([`CueSupport::confirms`]).
 
-use super::measured_cues::{Cue, predicted_cue};
+use super::measured_cues::{Cue, CueAxis, predicted_cue};
 use crate::geometry::Camera;
 use crate::io::MotionRecord;
+use std::collections::BTreeMap;
 
 /// Fewest cues a support is computed from.
 const MIN_CUES: usize = 100;
@@ -44,27 +45,35 @@ impl CueSupport {
     }
 }
 
-/// The support `cues` give `estimate` on a scene seen by `camera`: each component of each cue
-/// is weighted by the inverse variance of that component's residuals about the prediction
-/// (median absolute deviation), and residuals are clipped at three deviations. `None` with
-/// fewer than 100 cues the estimate images, or when it predicts no cue at all (no motion).
+/// The support `cues` give `estimate` on a scene seen by `camera`: each measured component of
+/// each cue ([`Cue::measured_axes`]) is weighted by the inverse variance of the residuals
+/// about the prediction of the components along its axis (median absolute deviation), and
+/// residuals are clipped at three deviations. `None` with fewer than 100 cues the estimate
+/// images, or when it predicts no cue at all (no motion).
 pub fn cue_support(camera: &Camera, estimate: &MotionRecord, cues: &[Cue]) -> Option<CueSupport> {
-    let pairs: Vec<((f64, f64), (f64, f64))> = cues.iter().filter_map(|c| Some((c.offset, predicted_cue(camera, estimate, c)?))).collect();
-    if pairs.len() < MIN_CUES {
+    // (measured, predicted) components, by axis.
+    let mut by_axis: BTreeMap<CueAxis, Vec<(f64, f64)>> = BTreeMap::new();
+    let mut imaged = 0;
+    for cue in cues {
+        let Some(predicted) = predicted_cue(camera, estimate, cue) else { continue };
+        imaged += 1;
+        for (axis, (ax, ay)) in cue.measured_axes() {
+            let along = |(du, dv): (f64, f64)| ax * du + ay * dv;
+            by_axis.entry(axis).or_default().push((along(cue.offset), along(predicted)));
+        }
+    }
+    if imaged < MIN_CUES {
         return None;
     }
-    let spread = |component: fn(&(f64, f64)) -> f64| {
-        let residuals: Vec<f64> = pairs.iter().map(|(m, p)| component(m) - component(p)).collect();
-        (1.4826 * median_absolute_deviation(residuals)).max(1e-6)
-    };
-    let (sx, sy) = (spread(|c| c.0), spread(|c| c.1));
     let (mut num, mut den) = (0.0, 0.0);
-    for (m, p) in &pairs {
-        let (rx, ry) = ((m.0 - p.0).clamp(-3.0 * sx, 3.0 * sx), (m.1 - p.1).clamp(-3.0 * sy, 3.0 * sy));
-        num += rx * p.0 / (sx * sx) + ry * p.1 / (sy * sy);
-        den += p.0 * p.0 / (sx * sx) + p.1 * p.1 / (sy * sy);
+    for pairs in by_axis.values() {
+        let spread = (1.4826 * median_absolute_deviation(pairs.iter().map(|(m, p)| m - p).collect())).max(1e-6);
+        for (m, p) in pairs {
+            num += (m - p).clamp(-3.0 * spread, 3.0 * spread) * p / (spread * spread);
+            den += p * p / (spread * spread);
+        }
     }
-    (den > 1e-12).then(|| CueSupport { share: 1.0 + num / den, standard_error: den.sqrt().recip(), cues: pairs.len() })
+    (den > 1e-12).then(|| CueSupport { share: 1.0 + num / den, standard_error: den.sqrt().recip(), cues: imaged })
 }
 
 /// The median absolute deviation of `values` from their median.
@@ -96,6 +105,40 @@ mod tests {
         }
     }
 
+    /// [`cues`], each made one-way across a direction that turns from cue to cue (the offset
+    /// keeps its component across it, with noise of 0.05 px along it).
+    fn one_way_cues(truth: &MotionRecord) -> Vec<Cue> {
+        let mut rng = Rng::new(11);
+        cues(truth)
+            .into_iter()
+            .enumerate()
+            .map(|(i, mut cue)| {
+                let angle = 0.37 * i as f64;
+                let n = (angle.cos(), angle.sin());
+                let across = n.0 * cue.offset.0 + n.1 * cue.offset.1 + 0.1 * (rng.unit() - 0.5);
+                cue.offset = (across * n.0, across * n.1);
+                cue.across = Some(n);
+                cue
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_way_cues_weigh_the_component_across_their_edges() {
+        let truth = MotionRecord::ConstantVelocity { omega_rad_s: [0.05, 0.3, 0.1], velocity_m_s: [0.8, 0.1, -0.3] };
+        let support = |m: &MotionRecord, cues: &[Cue]| cue_support(&camera(), m, cues).unwrap();
+        let measured = one_way_cues(&truth);
+        let right = support(&truth, &measured);
+        assert!((right.share - 1.0).abs() < 4.0 * right.standard_error + 0.02, "{right:?}");
+        let double = MotionRecord::ConstantVelocity { omega_rad_s: [0.1, 0.6, 0.2], velocity_m_s: [1.6, 0.2, -0.6] };
+        assert!((support(&double, &measured).share - 0.5).abs() < 0.05);
+        // Mixed with two-way cues, one support over both.
+        let mixed: Vec<Cue> = measured.into_iter().chain(cues(&truth)).collect();
+        let both = support(&truth, &mixed);
+        assert!((both.share - 1.0).abs() < 4.0 * both.standard_error + 0.02 && both.cues == mixed.len(), "{both:?}");
+        assert!(both.standard_error < right.standard_error, "{both:?} against {right:?}");
+    }
+
     /// Cues at assorted positions and disparities in the four corners, measured under `truth`
     /// with Gaussian noise of 0.05 px (0.1 px vertically).
     fn cues(truth: &MotionRecord) -> Vec<Cue> {
@@ -108,7 +151,7 @@ mod tests {
             .flat_map(|view| (0..400).map(move |i| (view, i)))
             .filter_map(|(view, i)| {
                 let at = (20.0 + (i % 20) as f64 * 11.0, 20.0 + (i / 20) as f64 * 11.0);
-                let mut cue = Cue { at, disparity: -1.0 + 0.005 * i as f64, view, offset: (0.0, 0.0) };
+                let mut cue = Cue { at, disparity: -1.0 + 0.005 * i as f64, view, offset: (0.0, 0.0), across: None };
                 let p = predicted_cue(&cam, truth, &cue)?;
                 cue.offset = (p.0 + 0.05 * normal(), p.1 + 0.1 * normal());
                 Some(cue)

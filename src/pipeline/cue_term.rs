@@ -14,7 +14,7 @@ use crate::model::{GaussianSet, Gaussians};
 use crate::render::StaticShape;
 use burn::module::Module;
 use burn::nn::loss::{HuberLoss, HuberLossConfig};
-use burn::tensor::{Device, Tensor, TensorData};
+use burn::tensor::{Device, Int, Tensor, TensorData};
 
 /// The measured cues as tensors, all views together.
 struct CuePoints {
@@ -22,9 +22,23 @@ struct CuePoints {
     points: Gaussians,
     /// Each point's off-row view.
     views: ViewOffset,
-    /// Where no motion puts each point in its view, plus its measured cue: `[N]` each way.
-    target_u: Tensor<1>,
-    target_v: Tensor<1>,
+    /// The measured components, `[K]` each ([`Cue::measured_axes`]: two for a patch textured
+    /// both ways, one across an edge or a stripe): the point each belongs to, its unit image
+    /// direction, and where no motion puts the point along it plus the measured cue.
+    point: Tensor<1, Int>,
+    axis_u: Tensor<1>,
+    axis_v: Tensor<1>,
+    target: Tensor<1>,
+}
+
+/// One measured component of a cue.
+struct Component {
+    /// The cue it belongs to.
+    point: usize,
+    /// The unit image direction it is measured along.
+    axis: (f64, f64),
+    /// Where no motion puts the cue's point along `axis`, plus the measured cue.
+    target: f64,
 }
 
 /// The measured-cue term of stage 2.
@@ -47,7 +61,20 @@ impl CueTerm {
         let n = cues.len();
         let tensor =
             |f: &dyn Fn(&Cue) -> f64| Tensor::<1>::from_data(TensorData::new(cues.iter().map(|c| f(c) as f32).collect(), [n]), device);
-        let still = |c: &Cue| camera.grid.position_in_view(c.view, c.at.0, c.at.1, c.disparity);
+        // The measured components, with the point each belongs to.
+        let components: Vec<Component> = cues
+            .iter()
+            .enumerate()
+            .flat_map(|(point, c)| {
+                let still = camera.grid.position_in_view(c.view, c.at.0, c.at.1, c.disparity);
+                let target = (still.0 + c.offset.0, still.1 + c.offset.1);
+                c.measured_axes().into_iter().map(move |(_, axis)| Component { point, axis, target: axis.0 * target.0 + axis.1 * target.1 })
+            })
+            .collect();
+        let k = components.len();
+        let column = |f: &dyn Fn(&Component) -> f64| {
+            Tensor::<1>::from_data(TensorData::new(components.iter().map(|c| f(c) as f32).collect(), [k]), device)
+        };
         let points = (n > 0).then(|| {
             let set = GaussianSet {
                 u: cues.iter().map(|c| c.at.0 as f32).collect(),
@@ -60,8 +87,10 @@ impl CueTerm {
             CuePoints {
                 points: set.to_module(device).no_grad(),
                 views: ViewOffset::PerPoint(tensor(&|c| camera.grid.offset(c.view).0), tensor(&|c| camera.grid.offset(c.view).1)),
-                target_u: tensor(&|c| still(c).0 + c.offset.0),
-                target_v: tensor(&|c| still(c).1 + c.offset.1),
+                point: Tensor::<1, Int>::from_data(TensorData::new(components.iter().map(|c| c.point as i64).collect(), [k]), device),
+                axis_u: column(&|c| c.axis.0),
+                axis_v: column(&|c| c.axis.1),
+                target: column(&|c| c.target),
             }
         });
         Self { cues: points, weight, huber: HuberLossConfig::new(huber_px).init(), timing_iterations, len: n }
@@ -73,8 +102,9 @@ impl CueTerm {
         let Some(cues) = &self.cues else { return Tensor::zeros([1], &params.device()) };
         let shape = StaticShape::new(&cues.points, camera, model, params.clone());
         let splats = shape.splats_rolling(model, params, cues.views.clone(), self.timing_iterations);
-        let sum = self.huber.forward_no_reduction(splats.u, cues.target_u.clone()).sum()
-            + self.huber.forward_no_reduction(splats.v, cues.target_v.clone()).sum();
+        let along =
+            splats.u.select(0, cues.point.clone()) * cues.axis_u.clone() + splats.v.select(0, cues.point.clone()) * cues.axis_v.clone();
+        let sum = self.huber.forward_no_reduction(along, cues.target.clone()).sum();
         sum * (self.weight / self.len as f32)
     }
 }

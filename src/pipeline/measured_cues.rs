@@ -14,12 +14,16 @@
 //! there are far larger than `μ` (docs/results.md).
 
 use super::spline_image::SplineImage;
-use super::view_tracking::{TrackSettings, textured_points, track_warped};
+use super::view_tracking::{PatchTexture, TrackSettings, classified_points, track_warped, track_warped_along};
 use crate::geometry::{Camera, ViewId, pose_at, readout_interval, rs_project};
 use crate::io::{MotionRecord, Raster, Scene};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// The least horizontal share of an edge's or a stripe's normal for its patch to give a cue: the
+/// disparity is matched along the row, and a nearly horizontal edge does not pin it.
+const MIN_ACROSS_X: f64 = 0.5;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
 /// it sits in one off-row view against where its disparity alone would put it.
@@ -32,18 +36,48 @@ pub struct Cue {
     pub disparity: f64,
     /// The off-row view.
     pub view: ViewId,
-    /// Its offset in that view from the position its disparity gives (px).
+    /// Its offset in that view from the position its disparity gives (px). For a patch textured
+    /// across `across` only, the measured component times that direction.
     pub offset: (f64, f64),
+    /// `None` for a patch textured in both directions, whose whole offset is measured; the unit
+    /// direction its texture varies along for an edge or a stripe, of whose offset only the
+    /// component along it is measured (the aperture problem).
+    pub across: Option<(f64, f64)>,
 }
 
-/// The measured cues of `scene` in `views` (e.g. the four corners), column by column: the patches
-/// of the central-row view of a view's column that are textured in both directions (on a grid of
-/// about 128 x 128), each tracked into the view of the central row farthest from it (which gives
-/// its disparity) and into the view. `guess` (a disparity map of the central view, e.g. the plane
-/// sweep's) only starts the tracking. Patches lost in either view, or found more than 0.25 px up
-/// or down in the row view (the row views are read at the same time, so that is a mismatch), are
-/// left out. Views of the central row (no vertical offset, no cue) or of the central column, views
-/// the scene lacks, and columns whose central-row view it lacks give no cues.
+impl Cue {
+    /// The unit image directions along which this cue's offset is measured, each with its kind:
+    /// x and y for a patch textured both ways, the one across an edge or a stripe.
+    pub fn measured_axes(&self) -> Vec<(CueAxis, (f64, f64))> {
+        match self.across {
+            None => vec![(CueAxis::Horizontal, (1.0, 0.0)), (CueAxis::Vertical, (0.0, 1.0))],
+            Some(normal) => vec![(CueAxis::Across, normal)],
+        }
+    }
+}
+
+/// The kind of direction a measured cue component lies along (their noise differs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum CueAxis {
+    /// Image x, of a patch textured both ways.
+    Horizontal,
+    /// Image y, of a patch textured both ways.
+    Vertical,
+    /// Across the edges of a patch textured one way.
+    Across,
+}
+
+/// The measured cues of `scene` in `views` (e.g. the four corners), column by column: the
+/// textured patches of the central-row view of a view's column (on a grid of about 128 x 128),
+/// each tracked into the view of the central row farthest from it (which gives its disparity)
+/// and into the view. A patch textured in both directions gives the whole cue; an edge or a
+/// stripe, matched along the row and then across itself, gives the cue's component across it
+/// (`Cue::across`), and is left out when it is too nearly horizontal to give the disparity.
+/// `guess` (a disparity map of the central view, e.g. the plane sweep's) only starts the
+/// tracking. Patches lost in either view, or found more than 0.25 px up or down in the row view
+/// (the row views are read at the same time, so that is a mismatch), are left out. Views of the
+/// central row (no vertical offset, no cue) or of the central column, views the scene lacks, and
+/// columns whose central-row view it lacks give no cues.
 ///
 /// A patch on a surface slanted in depth is sheared between row views and stretched between
 /// a row view and an off-row view by its disparity gradient, and a translation-only match of a
@@ -82,35 +116,56 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
         let Some(partner_img) = scene.view(partner) else { continue };
         let partner = &*partners.entry(partner).or_insert_with(|| SplineImage::new(partner_img));
         let row_img = row_img.to_grey();
-        let points = textured_points(&row_img, settings.radius, stride, 0.1);
+        // Edges and stripes measure the disparity only with horizontal texture across them.
+        let patches: Vec<((usize, usize), PatchTexture)> = classified_points(&row_img, settings.radius, stride, 0.1)
+            .into_iter()
+            .filter(|(_, texture)| !matches!(texture, PatchTexture::Across { normal } if normal.0.abs() < MIN_ACROSS_X))
+            .collect();
         // The patch of the row view, found in the partner view `baseline d` to the right: `d`.
-        let to_partner = |(x, y): (usize, usize), start: f64, slope: (f64, f64)| {
+        // A patch textured both ways is matched freely and must come out level; an edge or a
+        // stripe is matched along the row.
+        let to_partner = |(x, y): (usize, usize), texture: PatchTexture, start: f64, slope: (f64, f64)| {
             let linear = [[baseline * slope.0, baseline * slope.1], [0.0, 0.0]];
-            let found = track_warped(&row_img, partner, (x, y), (baseline * start, 0.0), linear, &settings)?.displacement;
+            let guess = (baseline * start, 0.0);
+            let found = match texture {
+                PatchTexture::Both => track_warped(&row_img, partner, (x, y), guess, linear, &settings)?.displacement,
+                PatchTexture::Across { .. } => {
+                    track_warped_along(&row_img, partner, (x, y), guess, linear, (1.0, 0.0), &settings)?.displacement
+                }
+            };
             (found.1.abs() <= 0.25).then_some(found.0 / baseline)
         };
-        let first: Vec<Option<f64>> = points
+        let first: Vec<Option<f64>> = patches
             .par_iter()
-            .map(|&(x, y)| {
+            .map(|&((x, y), texture)| {
                 let gx = ((x as f64 + a * guess_d0(guess, x, y)?).round().max(0.0) as usize).min(w - 1);
-                to_partner((x, y), guess_d0(guess, gx, y)?, (0.0, 0.0))
+                to_partner((x, y), texture, guess_d0(guess, gx, y)?, (0.0, 0.0))
             })
             .collect();
+        let points: Vec<(usize, usize)> = patches.iter().map(|p| p.0).collect();
         let first = PatchDisparities::new(&points, first, stride);
         // The neighbours a gradient is fitted to: those within a patch, or two grid steps.
         let reach = settings.radius.max(2 * stride);
-        let found: Vec<Vec<Cue>> = points
+        let found: Vec<Vec<Cue>> = patches
             .par_iter()
             .zip(&first.values)
-            .filter_map(|(&(x, y), &d1)| {
+            .filter_map(|(&((x, y), texture), &d1)| {
                 let slope = first.slope_at((x, y), reach)?;
-                let d = to_partner((x, y), d1?, slope)?;
-                // The same patch in each view of its column: `b d` rows up or down, and `μ`.
+                let d = to_partner((x, y), texture, d1?, slope)?;
+                // The same patch in each view of its column: `b d` rows up or down, and `μ` (its
+                // component across the edges of an edge or a stripe).
                 let in_views = targets.iter().filter_map(|(view, image)| {
                     let b = grid.offset(*view).1;
                     let linear = [[0.0, 0.0], [-b * slope.0, -b * slope.1]];
-                    let (dx, dy) = track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, &settings)?.displacement;
-                    Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d) })
+                    let guess = (0.0, -b * d);
+                    let (track, across) = match texture {
+                        PatchTexture::Both => (track_warped(&row_img, image, (x, y), guess, linear, &settings)?, None),
+                        PatchTexture::Across { normal } => {
+                            (track_warped_along(&row_img, image, (x, y), guess, linear, normal, &settings)?, Some(normal))
+                        }
+                    };
+                    let (dx, dy) = track.displacement;
+                    Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across })
                 });
                 Some(in_views.collect())
             })

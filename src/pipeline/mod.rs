@@ -378,13 +378,17 @@ fn stage2(
     let cues = (s.cue_weight > 0.0 || check).then(|| {
         let start = Instant::now();
         let cue_views = stage2_views(scene, s.cue_views);
-        let cues = measure_cues(scene, initial_disparity, &cue_views);
+        let mut cues = measure_cues(scene, initial_disparity, &cue_views);
+        if !s.cue_edges {
+            cues.retain(|c| c.across.is_none());
+        }
         let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
         log.lines.push(format!(
-            "stage 2 cues: {} measured in {} views off the central row and column ({:?}), textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
+            "stage 2 cues: {} measured in {} views off the central row and column ({:?}), {} of them across an edge or a stripe only, textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
             cues.len(),
             measured_in.len(),
             s.cue_views,
+            cues.iter().filter(|c| c.across.is_some()).count(),
             start.elapsed().as_secs_f64()
         ));
         cues

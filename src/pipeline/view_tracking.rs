@@ -1,9 +1,10 @@
 //! Sub-pixel displacement of small image patches between two views (Lucas–Kanade, translation
-//! only, inverse compositional), and the choice of patches that pin both directions of it.
+//! only, inverse compositional), and the choice of patches that pin it.
 //!
-//! A patch whose texture varies in one direction only (an edge, a stripe) fixes only the
-//! displacement across it; [`textured_points`] keeps the patches whose structure tensor has a
-//! large smaller eigenvalue, which fix both.
+//! A patch textured in both directions fixes its whole displacement. A patch whose texture
+//! varies in one direction only (an edge, a stripe) fixes only the displacement across it (the
+//! aperture problem): [`textured_points`] tells the two apart by the patch's structure tensor,
+//! and [`track_warped_along`] tracks the second kind along one direction.
 //!
 //! The second view is resampled by cubic B-spline interpolation ([`SplineImage`]): bilinear
 //! resampling would carry a match whose true displacement is a small fraction of a pixel about
@@ -66,30 +67,69 @@ fn smaller_eigenvalue((a, b, c): (f64, f64, f64)) -> f64 {
     0.5 * (a + c) - (0.25 * (a - c).powi(2) + b * b).sqrt()
 }
 
+/// How a patch's texture pins its displacement.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PatchTexture {
+    /// Textured in both directions: the whole displacement is pinned.
+    Both,
+    /// Textured across the unit direction `normal` only (an edge, a stripe along the other
+    /// direction): only the displacement's component along `normal` is pinned.
+    Across {
+        /// The unit direction the intensity varies along.
+        normal: (f64, f64),
+    },
+}
+
 /// Pixels of the grey image `grey`, on a grid of step `stride`, whose patch is textured in both
 /// directions: the structure tensor's smaller eigenvalue is at least `share` of the 90th
 /// percentile of that eigenvalue over the grid, and at least a quarter of the larger one (no
 /// edges or stripes). Returned top to bottom, left to right.
 pub fn textured_points(grey: &Raster, radius: usize, stride: usize, share: f64) -> Vec<(usize, usize)> {
+    classified_points(grey, radius, stride, share).into_iter().filter(|p| p.1 == PatchTexture::Both).map(|p| p.0).collect()
+}
+
+/// [`textured_points`], and with them the patches textured in one direction only whose larger
+/// eigenvalue passes the same floor: as much texture across them as the two-way patches have
+/// in their weaker direction. Returned top to bottom, left to right.
+pub fn classified_points(grey: &Raster, radius: usize, stride: usize, share: f64) -> Vec<((usize, usize), PatchTexture)> {
     let stride = stride.max(1);
     let margin = radius + 1;
-    let scored: Vec<((usize, usize), f64, f64)> = (margin..grey.height.saturating_sub(margin))
+    let scored: Vec<_> = (margin..grey.height.saturating_sub(margin))
         .step_by(stride)
         .flat_map(|y| (margin..grey.width.saturating_sub(margin)).step_by(stride).map(move |x| (x, y)))
-        .filter_map(|(x, y)| {
-            let t = structure_tensor(patch(grey, x, y, radius)?);
-            let small = smaller_eigenvalue(t);
-            Some(((x, y), small, t.0 + t.2 - small))
-        })
+        .filter_map(|(x, y)| Some(((x, y), structure_tensor(patch(grey, x, y, radius)?))))
         .collect();
-    let mut smalls: Vec<f64> = scored.iter().map(|s| s.1).collect();
+    let mut smalls: Vec<f64> = scored.iter().map(|s| smaller_eigenvalue(s.1)).collect();
     if smalls.is_empty() {
         return Vec::new();
     }
     smalls.sort_by(f64::total_cmp);
     let p90 = smalls[(smalls.len() * 9 / 10).min(smalls.len() - 1)];
     let floor = (share * p90).max(1e-12);
-    scored.into_iter().filter(|&(_, small, large)| small >= floor && small >= 0.25 * large).map(|s| s.0).collect()
+    scored
+        .into_iter()
+        .filter_map(|(at, t)| {
+            let small = smaller_eigenvalue(t);
+            let large = t.0 + t.2 - small;
+            if small >= floor && small >= 0.25 * large {
+                Some((at, PatchTexture::Both))
+            } else if large >= floor && small < 0.25 * large {
+                Some((at, PatchTexture::Across { normal: larger_eigenvector(t, large) }))
+            } else {
+                None
+            }
+        })
+        .collect()
+}
+
+/// The unit eigenvector of the symmetric 2x2 matrix `[[a, b], [b, c]]` for its eigenvalue
+/// `large` (the larger one).
+fn larger_eigenvector((a, b, c): (f64, f64, f64), large: f64) -> (f64, f64) {
+    // Rows of `M - large I` are orthogonal to the eigenvector; take the longer one for accuracy.
+    let (r1, r2) = ((a - large, b), (b, c - large));
+    let (x, y) = if r1.0.hypot(r1.1) >= r2.0.hypot(r2.1) { (-r1.1, r1.0) } else { (-r2.1, r2.0) };
+    let n = x.hypot(y);
+    if n > 0.0 { (x / n, y / n) } else { (1.0, 0.0) }
 }
 
 /// Tracks the patch of the grey image `from` centred on the integer pixel `at` into `to` (the
@@ -113,6 +153,37 @@ pub fn track_warped(
     linear: [[f64; 2]; 2],
     settings: &TrackSettings,
 ) -> Option<Track> {
+    track_core(from, to, at, guess, linear, None, settings)
+}
+
+/// [`track_warped`] with the displacement moved from `guess` along the unit vector `direction`
+/// only: for a patch textured in one direction ([`PatchTexture::Across`]), whose displacement
+/// along its edges no match can tell, and for a match whose direction is known (the horizontal
+/// parallax between views of one row). `None` also when the patch has no texture along
+/// `direction`.
+pub fn track_warped_along(
+    from: &Raster,
+    to: &SplineImage,
+    at: (usize, usize),
+    guess: (f64, f64),
+    linear: [[f64; 2]; 2],
+    direction: (f64, f64),
+    settings: &TrackSettings,
+) -> Option<Track> {
+    track_core(from, to, at, guess, linear, Some(direction), settings)
+}
+
+/// The Gauss–Newton iteration of [`track_warped`] (`along` = `None`) and of
+/// [`track_warped_along`].
+fn track_core(
+    from: &Raster,
+    to: &SplineImage,
+    at: (usize, usize),
+    guess: (f64, f64),
+    linear: [[f64; 2]; 2],
+    along: Option<(f64, f64)>,
+    settings: &TrackSettings,
+) -> Option<Track> {
     let r = settings.radius;
     if (from.width, from.height) != (to.width, to.height) {
         return None;
@@ -121,8 +192,17 @@ pub fn track_warped(
     // The template and its gradients, whose structure tensor is the Hessian of every step.
     let template: Vec<_> = patch(from, x0, y0, r)?.collect();
     let (sxx, sxy, syy) = structure_tensor(template.iter().copied());
-    let det = sxx * syy - sxy * sxy;
-    if det <= 1e-18 * (sxx + syy).powi(2).max(1e-30) {
+    // The Hessian's determinant in both directions, or its value along `along`: too small, the
+    // patch does not pin the displacement.
+    let (det, along_h) = match along {
+        None => (sxx * syy - sxy * sxy, 0.0),
+        Some((nx, ny)) => (0.0, nx * nx * sxx + 2.0 * nx * ny * sxy + ny * ny * syy),
+    };
+    let pinned = match along {
+        None => det > 1e-18 * (sxx + syy).powi(2).max(1e-30),
+        Some(_) => along_h > 1e-9 * (sxx + syy).max(1e-30),
+    };
+    if !pinned {
         return None;
     }
     let [[l00, l01], [l10, l11]] = linear;
@@ -137,9 +217,15 @@ pub fn track_warped(
             by += gy * e;
             ss += e * e;
         }
-        // Inverse compositional step: solve H Δ = b with the template's Hessian, then move back by Δ.
-        let step_x = (syy * bx - sxy * by) / det;
-        let step_y = (sxx * by - sxy * bx) / det;
+        // Inverse compositional step: solve H Δ = b with the template's Hessian (restricted to
+        // `along` when given), then move back by Δ.
+        let (step_x, step_y) = match along {
+            None => ((syy * bx - sxy * by) / det, (sxx * by - sxy * bx) / det),
+            Some((nx, ny)) => {
+                let s = (nx * bx + ny * by) / along_h;
+                (s * nx, s * ny)
+            }
+        };
         dx -= step_x;
         dy -= step_y;
         if (dx - guess.0).hypot(dy - guess.1) > settings.max_correction {
@@ -247,6 +333,52 @@ mod tests {
         assert!(track(&stripes, &SplineImage::new(&stripes), (24, 24), (0.0, 0.0), &TrackSettings::default()).is_none());
         let tex = texture(48, 48, 0.0, 0.0);
         assert!(!textured_points(&tex, 4, 4, 0.1).is_empty());
+        // Beside a two-way texture (whose patches set the floor), every stripe patch is classed
+        // as varying along x.
+        let side_by_side = Raster::from_f64_fn(96, 48, |x, y| {
+            if x < 48.0 { tex.data[y as usize * 48 + x as usize] as f64 } else { stripes.data[y as usize * 48 + x as usize - 48] as f64 }
+        });
+        let classes = classified_points(&side_by_side, 4, 4, 0.1);
+        assert!(classes.iter().any(|p| p.0.0 < 43 && p.1 == PatchTexture::Both), "{classes:?}");
+        let striped: Vec<_> = classes.iter().filter(|p| p.0.0 >= 53).collect();
+        assert!(!striped.is_empty(), "{classes:?}");
+        for (at, class) in striped {
+            let PatchTexture::Across { normal } = class else { panic!("{at:?}: {class:?}") };
+            assert!(normal.0.abs() > 0.999, "{at:?}: {normal:?}");
+        }
+    }
+
+    #[test]
+    fn a_diagonal_stripe_is_tracked_across_itself_and_along_the_row() {
+        // Stripes varying along n = (0.8, -0.6), moved by (0.7, 0.9): only n · shift = 0.02 px
+        // is seen; along the row, the same stripe is found 0.02 / 0.8 px to the side.
+        let n = (0.8, -0.6);
+        let stripes = |sx: f64, sy: f64| {
+            Raster::from_f64_fn(64, 64, move |x, y| {
+                let s = n.0 * (x - sx) + n.1 * (y - sy);
+                0.5 + 0.3 * (0.7 * s).sin() + 0.1 * (1.3 * s).cos()
+            })
+        };
+        let (from, shift) = (stripes(0.0, 0.0), (0.7, 0.9));
+        let to = SplineImage::new(&stripes(shift.0, shift.1));
+        let across = n.0 * shift.0 + n.1 * shift.1;
+        let classes = classified_points(&from, 4, 8, 0.1);
+        assert!(!classes.is_empty());
+        let settings = TrackSettings::default();
+        for (at, class) in classes {
+            let PatchTexture::Across { normal } = class else { panic!("{at:?}: {class:?}") };
+            assert!((normal.0 * n.0 + normal.1 * n.1).abs() > 0.999, "{at:?}: {normal:?}");
+            let t = track_warped_along(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], normal, &settings).unwrap();
+            let found = t.displacement.0 * normal.0 + t.displacement.1 * normal.1;
+            let expected = across * (normal.0 * n.0 + normal.1 * n.1);
+            assert!((found - expected).abs() < 2e-3, "{at:?}: {found} against {expected}");
+            // The displacement stays along the normal: nothing is invented along the stripe.
+            assert!((t.displacement.0 * normal.1 - t.displacement.1 * normal.0).abs() < 1e-12, "{t:?}");
+            let row = track_warped_along(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], (1.0, 0.0), &settings).unwrap();
+            assert!((row.displacement.0 - across / n.0).abs() < 3e-3 && row.displacement.1 == 0.0, "{row:?}");
+        }
+        // Along the stripes themselves nothing can be tracked.
+        assert!(track_warped_along(&from, &to, (32, 32), (0.0, 0.0), [[0.0; 2]; 2], (0.6, 0.8), &settings).is_none());
     }
 
     #[test]
