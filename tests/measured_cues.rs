@@ -1,7 +1,8 @@
 //! Rolling-shutter cues measured from the views alone: zero in every off-row view of a real
 //! still light field (HCI antinous, whose views are synchronised and whose vertical and
-//! horizontal baselines are equal), the true motion's on a generated moving one (from patches
-//! textured both ways and from edges and stripes alike), and the
+//! horizontal baselines are equal; patches textured both ways and edges alike), the true
+//! motion's on a generated moving one (both kinds again), the check's verdicts with the
+//! patches textured both ways (the cues it uses), and the
 //! stage-2 cue term (a burn tensor program) agrees with the host prediction it is built from.
 
 mod common;
@@ -26,7 +27,7 @@ fn antinous_off_row_views_sit_where_the_central_row_disparity_puts_them() {
     let scene = Scene::load(&dir).unwrap();
     let guess = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
     let views = stage2_views(&scene, ViewSelection::AllOffRow);
-    let cues = measure_cues(&scene, &guess, &views);
+    let cues = measure_cues(&scene, &guess, &views, true);
     let (mx, my) = (median(cues.iter().map(|c| c.offset.0.abs()).collect()), median(cues.iter().map(|c| c.offset.1.abs()).collect()));
     let (sx, sy) = (median(cues.iter().map(|c| c.offset.0).collect()), median(cues.iter().map(|c| c.offset.1).collect()));
     eprintln!("{} cues; median |offset| {mx:.4} / {my:.4} px, median offset {sx:.4} / {sy:.4} px", cues.len());
@@ -74,7 +75,7 @@ fn a_pan_shows_in_the_measured_cues_as_its_motion_predicts_them() {
     let (_dir, scene) = moving_objects(&truth);
     let camera = scene.camera().unwrap();
     let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
-    let cues = measure_cues(&scene, gt.disparity.as_ref().unwrap(), &scene.grid.corners());
+    let cues = measure_cues(&scene, gt.disparity.as_ref().unwrap(), &scene.grid.corners(), true);
     assert!(cues.len() > 2000, "{} cues", cues.len());
     // Patches textured both ways and edges or stripes (the objects' background) both give cues.
     let one_way = cues.iter().filter(|c| c.across.is_some()).count();
@@ -166,7 +167,7 @@ fn a_still_capture_refutes_a_pan_and_a_generated_pan_bears_out_its_own_motion() 
     let camera = rslf::geometry::Camera { line_time_s: 5e-5, ..scene.camera().unwrap() };
     let config = rslf::config::Config::default();
     let guess = plane_sweep(&scene, &scene.central_row_views(), &sweep_settings(&config, &scene), |_, _| {}).disparity;
-    let cues = measure_cues(&scene, &guess, &scene.grid.corners());
+    let cues = measure_cues(&scene, &guess, &scene.grid.corners(), false);
     // The drift the photometric fit settles in on still suite scenes (roll and zoom), and a pan.
     let drift = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.0, 0.2], velocity_m_s: [0.0, 0.0, -0.4] };
     let pan = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.3, 0.0], velocity_m_s: [0.0, 0.0, 0.0] };
@@ -176,17 +177,14 @@ fn a_still_capture_refutes_a_pan_and_a_generated_pan_bears_out_its_own_motion() 
     // The views show no pan, and the check refutes one.
     assert!(of_pan.share.abs() < 0.15 && of_pan.refutes(0.5) && !of_pan.confirms(0.5), "{of_pan:?}");
     // Dino's disparities are small, so a roll-and-zoom drift of this size moves its cues by
-    // about 0.01 px. From the patches textured both ways alone that was too little to judge
-    // (standard error over 0.1); with its edges and stripes too (18,949 of the 24,839 cues)
-    // the check refutes it (measured: 0.20 ± 0.04).
-    let one_way = cues.iter().filter(|c| c.across.is_some()).count();
-    eprintln!("dino: {one_way} one-way cues");
-    assert!(of_drift.standard_error < 0.1 && of_drift.refutes(0.5) && !of_drift.confirms(0.5), "{of_drift:?}");
+    // about 0.01 px: too little to refute, and too little to confirm, so the check keeps no
+    // motion either way.
+    assert!(of_drift.standard_error > 0.1 && !of_drift.refutes(0.5) && !of_drift.confirms(0.5), "{of_drift:?}");
     // A generated pan: its own motion is borne out in full, half of it by half.
     let (_dir, moving) = moving_objects(&pan);
     let camera = moving.camera().unwrap();
     let guess = plane_sweep(&moving, &moving.central_row_views(), &sweep_settings(&config, &moving), |_, _| {}).disparity;
-    let cues = measure_cues(&moving, &guess, &moving.grid.corners());
+    let cues = measure_cues(&moving, &guess, &moving.grid.corners(), false);
     let full = cue_support(&camera, &pan, &cues).unwrap();
     let half = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.6, 0.0], velocity_m_s: [0.0, 0.0, 0.0] };
     let double = cue_support(&camera, &half, &cues).unwrap();

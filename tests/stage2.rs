@@ -157,11 +157,10 @@ fn aperture_weighting_reaches_the_motion_only_the_joint_refinement_sees_every_pi
 
 #[test]
 fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
-    // Measured on these scenes (with the cues of edges and stripes): the photometric fit of the
-    // turning scene has a support of 0.78 (± 0.03), that of the still one 0.16 (± 0.07); at the
-    // default 0.5 the cues confirm the first (0.72 after two standard errors) and refute the
-    // second (0.30); at 0.75 the first is neither refuted nor confirmed. (From the patches
-    // textured both ways alone: 0.74 ± 0.05 and -0.20 ± 0.11.)
+    // Measured on these scenes: the photometric fit of the turning scene has a support of 0.74
+    // (± 0.05), that of the still one -0.20 (± 0.11); at the default 0.5 the cues confirm the
+    // first (0.64 after two standard errors) and refute the second (0.02); at 0.75 the first is
+    // neither refuted nor confirmed.
     let (turning, still) = (common::tempdir(), common::tempdir());
     generate_turning(turning.path(), 1.0);
     generate_turning(still.path(), 0.0);
@@ -205,18 +204,28 @@ fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
     let fits = lines(&stdout, "stage 2 fit");
     assert!(fits.len() == 1 && fits[0].contains("measured-cue term ×1 over"), "{stdout}");
     assert!(!stdout.contains("stage 2 check"), "{stdout}");
-    // Edges and stripes add cues (the component across them); `cue_edges = false` leaves them out.
+    // Patches textured both ways only by default; `cue_edges = true` adds the edges and stripes
+    // (the cue's component across them) to the fit's cues, and the check still leaves them out.
+    // (Their disparities join the neighbours' local planes, so the two-way cues differ too.)
     let cue_counts = |stdout: &str| {
         let line = lines(stdout, "stage 2 cues: ").pop().unwrap_or_default();
         let number = |after: &str| line.split(after).nth(1)?.split_whitespace().next()?.parse::<usize>().ok();
         (number("stage 2 cues: ").unwrap_or(0), number("), ").unwrap_or(usize::MAX))
     };
-    let (all, across) = cue_counts(&stdout);
+    let (two_way, none_across) = cue_counts(&stdout);
     let root = turning.path();
-    let extra = "iterations = 10\ncue_weight = 1.0\nmin_cue_support = 0.0\ncue_edges = false";
-    let (two_way, none_across) = cue_counts(&train(root, &config(root, "two_way", "constant_velocity", extra), "two_way"));
-    eprintln!("{all} cues, {across} across an edge; without edges {two_way}, {none_across} across");
-    assert!(across > 0 && none_across == 0 && two_way == all - across, "{all} / {across}; {two_way} / {none_across}");
+    let extra = "iterations = 10\ncue_weight = 1.0\nmin_cue_support = 0.5\ncue_edges = true";
+    let stdout = train(root, &config(root, "edges", "constant_velocity", extra), "edges");
+    let (all, across) = cue_counts(&stdout);
+    eprintln!("{two_way} cues, {none_across} across an edge; with edges {all}, {across} across");
+    assert!(none_across == 0 && across > two_way / 2 && all > across, "{two_way} / {none_across}; {all} / {across}");
+    let check = lines(&stdout, "stage 2 check: ");
+    assert!(
+        check.len() == 1 && check[0].contains(&format!("the {} measured cues of patches textured both ways", all - across)),
+        "{stdout}"
+    );
+    let second = lines(&stdout, "stage 2 fit with the measured cues: ");
+    assert!(second.len() == 1 && second[0].contains(&format!("measured-cue term ×1 over {all} cues")), "{stdout}");
 }
 
 #[test]

@@ -209,10 +209,11 @@ pub struct Stage2Config {
     /// the central row and the central column, each tracked from the central-row view of its
     /// column).
     pub cue_views: ViewSelection,
-    /// Edges and stripes (patches textured one way) give cues too: the component of the cue
-    /// across them. They reach rows that patches textured both ways leave without cues (a
-    /// striped wall), which a model with rates per part of the read-out needs; they carry
-    /// biases of a few percent of the cue that the two-way patches do not (docs/results.md).
+    /// Edges and stripes (patches textured one way) give cues to the fit too: the component of
+    /// the cue across them. They reach rows that patches textured both ways leave without cues
+    /// (a striped wall), which a model with rates per part of the read-out needs, but carry
+    /// biases of a few percent of the cue that the two-way patches do not (docs/results.md), so
+    /// the check never uses them.
     pub cue_edges: bool,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
@@ -246,7 +247,7 @@ impl Default for Stage2Config {
             cue_weight: 1.0,
             min_cue_support: 0.5,
             cue_views: ViewSelection::Corners,
-            cue_edges: true,
+            cue_edges: false,
             initial_motion: None,
             newton_iterations: 5,
         }

@@ -70,9 +70,10 @@ pub enum CueAxis {
 /// The measured cues of `scene` in `views` (e.g. the four corners), column by column: the
 /// textured patches of the central-row view of a view's column (on a grid of about 128 x 128),
 /// each tracked into the view of the central row farthest from it (which gives its disparity)
-/// and into the view. A patch textured in both directions gives the whole cue; an edge or a
-/// stripe, matched along the row and then across itself, gives the cue's component across it
-/// (`Cue::across`), and is left out when it is too nearly horizontal to give the disparity.
+/// and into the view. A patch textured in both directions gives the whole cue. With `edges`, an
+/// edge or a stripe, matched along the row and then across itself, gives the cue's component
+/// across it (`Cue::across`), unless it is too nearly horizontal to give the disparity; its
+/// disparity then also joins its neighbours' local planes (below).
 /// `guess` (a disparity map of the central view, e.g. the plane sweep's) only starts the
 /// tracking. Patches lost in either view, or found more than 0.25 px up or down in the row view
 /// (the row views are read at the same time, so that is a mismatch), are left out. Views of the
@@ -91,7 +92,7 @@ pub enum CueAxis {
 /// Both matches resample the second view by cubic B-spline ([`SplineImage`]): a cue is a small
 /// fraction of a pixel sideways, where bilinear resampling would carry every match about
 /// 0.01 px too far.
-pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue> {
+pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
     let grid = scene.grid;
     let (Some(centre), w, h) = (grid.central(), scene.width(), scene.height()) else { return Vec::new() };
     let settings = TrackSettings::default();
@@ -116,10 +117,14 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId]) -> Vec<Cue>
         let Some(partner_img) = scene.view(partner) else { continue };
         let partner = &*partners.entry(partner).or_insert_with(|| SplineImage::new(partner_img));
         let row_img = row_img.to_grey();
-        // Edges and stripes measure the disparity only with horizontal texture across them.
+        // Edges and stripes, when asked for, measure the disparity only with horizontal texture
+        // across them.
         let patches: Vec<((usize, usize), PatchTexture)> = classified_points(&row_img, settings.radius, stride, 0.1)
             .into_iter()
-            .filter(|(_, texture)| !matches!(texture, PatchTexture::Across { normal } if normal.0.abs() < MIN_ACROSS_X))
+            .filter(|(_, texture)| match texture {
+                PatchTexture::Both => true,
+                PatchTexture::Across { normal } => edges && normal.0.abs() >= MIN_ACROSS_X,
+            })
             .collect();
         // The patch of the row view, found in the partner view `baseline d` to the right: `d`.
         // A patch textured both ways is matched freely and must come out level; an edge or a
