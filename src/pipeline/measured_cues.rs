@@ -14,7 +14,7 @@
 //! there are far larger than `μ` (docs/results.md).
 
 use super::spline_image::SplineImage;
-use super::view_tracking::{PatchTexture, TrackSettings, classified_points, track_warped, track_warped_along};
+use super::view_tracking::{PatchTexture, TrackSettings, classified_points, track_warped};
 use crate::geometry::{Camera, ViewId, pose_at, readout_interval, rs_project};
 use crate::io::{MotionRecord, Raster, Scene};
 use nalgebra::{Matrix3, Vector3};
@@ -132,12 +132,8 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
         let to_partner = |(x, y): (usize, usize), texture: PatchTexture, start: f64, slope: (f64, f64)| {
             let linear = [[baseline * slope.0, baseline * slope.1], [0.0, 0.0]];
             let guess = (baseline * start, 0.0);
-            let found = match texture {
-                PatchTexture::Both => track_warped(&row_img, partner, (x, y), guess, linear, &settings)?.displacement,
-                PatchTexture::Across { .. } => {
-                    track_warped_along(&row_img, partner, (x, y), guess, linear, (1.0, 0.0), &settings)?.displacement
-                }
-            };
+            let along = texture.normal().map(|_| (1.0, 0.0));
+            let found = track_warped(&row_img, partner, (x, y), guess, linear, along, &settings)?.displacement;
             (found.1.abs() <= 0.25).then_some(found.0 / baseline)
         };
         let first: Vec<Option<f64>> = patches
@@ -162,13 +158,8 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
                 let in_views = targets.iter().filter_map(|(view, image)| {
                     let b = grid.offset(*view).1;
                     let linear = [[0.0, 0.0], [-b * slope.0, -b * slope.1]];
-                    let guess = (0.0, -b * d);
-                    let (track, across) = match texture {
-                        PatchTexture::Both => (track_warped(&row_img, image, (x, y), guess, linear, &settings)?, None),
-                        PatchTexture::Across { normal } => {
-                            (track_warped_along(&row_img, image, (x, y), guess, linear, normal, &settings)?, Some(normal))
-                        }
-                    };
+                    let across = texture.normal();
+                    let track = track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, across, &settings)?;
                     let (dx, dy) = track.displacement;
                     Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across })
                 });

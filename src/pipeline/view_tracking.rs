@@ -4,7 +4,7 @@
 //! A patch textured in both directions fixes its whole displacement. A patch whose texture
 //! varies in one direction only (an edge, a stripe) fixes only the displacement across it (the
 //! aperture problem): [`textured_points`] tells the two apart by the patch's structure tensor,
-//! and [`track_warped_along`] tracks the second kind along one direction.
+//! and [`track_warped`] tracks the second kind along one direction.
 //!
 //! The second view is resampled by cubic B-spline interpolation ([`SplineImage`]): bilinear
 //! resampling would carry a match whose true displacement is a small fraction of a pixel about
@@ -80,6 +80,16 @@ pub enum PatchTexture {
     },
 }
 
+impl PatchTexture {
+    /// The direction the texture varies along, for a patch textured one way.
+    pub fn normal(&self) -> Option<(f64, f64)> {
+        match self {
+            PatchTexture::Both => None,
+            PatchTexture::Across { normal } => Some(*normal),
+        }
+    }
+}
+
 /// Pixels of the grey image `grey`, on a grid of step `stride`, whose patch is textured in both
 /// directions: the structure tensor's smaller eigenvalue is at least `share` of the 90th
 /// percentile of that eigenvalue over the grid, and at least a quarter of the larger one (no
@@ -137,7 +147,7 @@ fn larger_eigenvector((a, b, c): (f64, f64, f64), large: f64) -> (f64, f64) {
 /// patch is flat or leaves either image, the iteration does not settle, or it ends farther than
 /// `settings.max_correction` from the guess.
 pub fn track(from: &Raster, to: &SplineImage, at: (usize, usize), guess: (f64, f64), settings: &TrackSettings) -> Option<Track> {
-    track_warped(from, to, at, guess, [[0.0; 2]; 2], settings)
+    track_warped(from, to, at, guess, [[0.0; 2]; 2], None, settings)
 }
 
 /// [`track`] for a patch that also deforms by a known linear map: the pixel at offset `o` from
@@ -145,37 +155,12 @@ pub fn track(from: &Raster, to: &SplineImage, at: (usize, usize), guess: (f64, f
 /// estimated. A surface slanted in depth stretches or shears a patch between views by its
 /// disparity gradient; a translation-only match then lands where the patch's gradient energy
 /// is centred, not at its centre, which differs between horizontal and vertical matches.
+///
+/// With `along` (a unit vector) the displacement moves from `guess` along it only: for a patch
+/// textured in one direction ([`PatchTexture::Across`]), whose displacement along its edges no
+/// match can tell, and for a match whose direction is known (the horizontal parallax between
+/// views of one row). `None` also when the patch has no texture along `along`.
 pub fn track_warped(
-    from: &Raster,
-    to: &SplineImage,
-    at: (usize, usize),
-    guess: (f64, f64),
-    linear: [[f64; 2]; 2],
-    settings: &TrackSettings,
-) -> Option<Track> {
-    track_core(from, to, at, guess, linear, None, settings)
-}
-
-/// [`track_warped`] with the displacement moved from `guess` along the unit vector `direction`
-/// only: for a patch textured in one direction ([`PatchTexture::Across`]), whose displacement
-/// along its edges no match can tell, and for a match whose direction is known (the horizontal
-/// parallax between views of one row). `None` also when the patch has no texture along
-/// `direction`.
-pub fn track_warped_along(
-    from: &Raster,
-    to: &SplineImage,
-    at: (usize, usize),
-    guess: (f64, f64),
-    linear: [[f64; 2]; 2],
-    direction: (f64, f64),
-    settings: &TrackSettings,
-) -> Option<Track> {
-    track_core(from, to, at, guess, linear, Some(direction), settings)
-}
-
-/// The Gauss–Newton iteration of [`track_warped`] (`along` = `None`) and of
-/// [`track_warped_along`].
-fn track_core(
     from: &Raster,
     to: &SplineImage,
     at: (usize, usize),
@@ -284,7 +269,7 @@ mod tests {
         let to = SplineImage::new(&Raster::from_f64_fn(64, 64, |x, y| f(x - shift.0, c + (y - c - shift.1) / (1.0 + stretch))));
         let settings = TrackSettings::default();
         let plain = track(&from, &to, (32, 32), (0.0, -2.0), &settings).unwrap().displacement;
-        let warped = track_warped(&from, &to, (32, 32), (0.0, -2.0), [[0.0, 0.0], [0.0, stretch]], &settings).unwrap().displacement;
+        let warped = track_warped(&from, &to, (32, 32), (0.0, -2.0), [[0.0, 0.0], [0.0, stretch]], None, &settings).unwrap().displacement;
         let miss = |d: (f64, f64)| (d.0 - shift.0).hypot(d.1 - shift.1);
         assert!(miss(warped) < 0.02, "warped {warped:?}");
         assert!(miss(plain) > 3.0 * miss(warped), "translation only {plain:?}, warped {warped:?}");
@@ -368,17 +353,17 @@ mod tests {
         for (at, class) in classes {
             let PatchTexture::Across { normal } = class else { panic!("{at:?}: {class:?}") };
             assert!((normal.0 * n.0 + normal.1 * n.1).abs() > 0.999, "{at:?}: {normal:?}");
-            let t = track_warped_along(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], normal, &settings).unwrap();
+            let t = track_warped(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], Some(normal), &settings).unwrap();
             let found = t.displacement.0 * normal.0 + t.displacement.1 * normal.1;
             let expected = across * (normal.0 * n.0 + normal.1 * n.1);
             assert!((found - expected).abs() < 2e-3, "{at:?}: {found} against {expected}");
             // The displacement stays along the normal: nothing is invented along the stripe.
             assert!((t.displacement.0 * normal.1 - t.displacement.1 * normal.0).abs() < 1e-12, "{t:?}");
-            let row = track_warped_along(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], (1.0, 0.0), &settings).unwrap();
+            let row = track_warped(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], Some((1.0, 0.0)), &settings).unwrap();
             assert!((row.displacement.0 - across / n.0).abs() < 3e-3 && row.displacement.1 == 0.0, "{row:?}");
         }
         // Along the stripes themselves nothing can be tracked.
-        assert!(track_warped_along(&from, &to, (32, 32), (0.0, 0.0), [[0.0; 2]; 2], (0.6, 0.8), &settings).is_none());
+        assert!(track_warped(&from, &to, (32, 32), (0.0, 0.0), [[0.0; 2]; 2], Some((0.6, 0.8)), &settings).is_none());
     }
 
     #[test]
