@@ -126,7 +126,10 @@ mod tests {
     #[test]
     fn one_way_cues_weigh_the_component_across_their_edges() {
         let truth = MotionRecord::ConstantVelocity { omega_rad_s: [0.05, 0.3, 0.1], velocity_m_s: [0.8, 0.1, -0.3] };
-        let support = |m: &MotionRecord, cues: &[Cue]| cue_support(&camera(), m, cues).unwrap();
+        let support = |m: &MotionRecord, cues: &[Cue]| {
+            let Some(support) = cue_support(&camera(), m, cues) else { panic!("no support from {} cues", cues.len()) };
+            support
+        };
         let measured = one_way_cues(&truth);
         let right = support(&truth, &measured);
         assert!((right.share - 1.0).abs() < 4.0 * right.standard_error + 0.02, "{right:?}");

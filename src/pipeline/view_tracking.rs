@@ -353,13 +353,17 @@ mod tests {
         for (at, class) in classes {
             let PatchTexture::Across { normal } = class else { panic!("{at:?}: {class:?}") };
             assert!((normal.0 * n.0 + normal.1 * n.1).abs() > 0.999, "{at:?}: {normal:?}");
-            let t = track_warped(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], Some(normal), &settings).unwrap();
+            let Some(t) = track_warped(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], Some(normal), &settings) else {
+                panic!("{at:?}: lost across the stripe")
+            };
             let found = t.displacement.0 * normal.0 + t.displacement.1 * normal.1;
             let expected = across * (normal.0 * n.0 + normal.1 * n.1);
             assert!((found - expected).abs() < 2e-3, "{at:?}: {found} against {expected}");
             // The displacement stays along the normal: nothing is invented along the stripe.
             assert!((t.displacement.0 * normal.1 - t.displacement.1 * normal.0).abs() < 1e-12, "{t:?}");
-            let row = track_warped(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], Some((1.0, 0.0)), &settings).unwrap();
+            let Some(row) = track_warped(&from, &to, at, (0.0, 0.0), [[0.0; 2]; 2], Some((1.0, 0.0)), &settings) else {
+                panic!("{at:?}: lost along the row")
+            };
             assert!((row.displacement.0 - across / n.0).abs() < 3e-3 && row.displacement.1 == 0.0, "{row:?}");
         }
         // Along the stripes themselves nothing can be tracked.
