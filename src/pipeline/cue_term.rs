@@ -8,6 +8,7 @@
 //! penalty of the difference, in pixels.
 
 use super::measured_cues::Cue;
+use super::params_tensor;
 use crate::geometry::{Camera, TensorCamera, ViewOffset};
 use crate::model::motion::MotionModel;
 use crate::model::{GaussianSet, Gaussians};
@@ -59,8 +60,6 @@ impl CueTerm {
     /// The term for `cues` of a scene seen by `camera`, on `device`.
     pub fn new(cues: &[Cue], camera: &Camera, weight: f32, huber_px: f32, timing_iterations: usize, device: &Device) -> Self {
         let n = cues.len();
-        let tensor =
-            |f: &dyn Fn(&Cue) -> f64| Tensor::<1>::from_data(TensorData::new(cues.iter().map(|c| f(c) as f32).collect(), [n]), device);
         // The measured components, with the point each belongs to.
         let components: Vec<Component> = cues
             .iter()
@@ -72,9 +71,6 @@ impl CueTerm {
             })
             .collect();
         let k = components.len();
-        let column = |f: &dyn Fn(&Component) -> f64| {
-            Tensor::<1>::from_data(TensorData::new(components.iter().map(|c| f(c) as f32).collect(), [k]), device)
-        };
         let points = (n > 0).then(|| {
             let set = GaussianSet {
                 u: cues.iter().map(|c| c.at.0 as f32).collect(),
@@ -86,11 +82,14 @@ impl CueTerm {
             };
             CuePoints {
                 points: set.to_module(device).no_grad(),
-                views: ViewOffset::PerPoint(tensor(&|c| camera.grid.offset(c.view).0), tensor(&|c| camera.grid.offset(c.view).1)),
+                views: ViewOffset::PerPoint(
+                    column(cues, |c| camera.grid.offset(c.view).0, device),
+                    column(cues, |c| camera.grid.offset(c.view).1, device),
+                ),
                 point: Tensor::<1, Int>::from_data(TensorData::new(components.iter().map(|c| c.point as i64).collect(), [k]), device),
-                axis_u: column(&|c| c.axis.0),
-                axis_v: column(&|c| c.axis.1),
-                target: column(&|c| c.target),
+                axis_u: column(&components, |c| c.axis.0, device),
+                axis_v: column(&components, |c| c.axis.1, device),
+                target: column(&components, |c| c.target, device),
             }
         });
         Self { cues: points, weight, huber: HuberLossConfig::new(huber_px).init(), timing_iterations, len: n }
@@ -107,4 +106,9 @@ impl CueTerm {
         let sum = self.huber.forward_no_reduction(along, cues.target.clone()).sum();
         sum * (self.weight / self.len as f32)
     }
+}
+
+/// One value of each item as a tensor `[N]`.
+fn column<T>(items: &[T], value: impl Fn(&T) -> f64, device: &Device) -> Tensor<1> {
+    params_tensor(&items.iter().map(value).collect::<Vec<_>>(), device)
 }
