@@ -14,7 +14,7 @@
 //! there are far larger than `μ` (docs/results.md).
 
 use super::spline_image::SplineImage;
-use super::view_tracking::{PatchTexture, TrackSettings, classified_points, track_warped};
+use super::view_tracking::{PatchTexture, Track, TrackSettings, classified_points, track_warped};
 use crate::geometry::{Camera, ViewId, pose_at, readout_interval, rs_project};
 use crate::io::{MotionRecord, Raster, Scene};
 use nalgebra::{Matrix3, Vector3};
@@ -24,6 +24,14 @@ use std::collections::HashMap;
 /// The least horizontal share of an edge's or a stripe's normal for its patch to give a cue: the
 /// disparity is matched along the row, and a nearly horizontal edge does not pin it.
 const MIN_ACROSS_X: f64 = 0.5;
+
+/// The largest residual, as a share of the patch's contrast ([`Track::relative_residual`]), of
+/// either match of an edge or a stripe. On a still `objects` scene its one-way patches where an
+/// outline crosses the striped wall sat up to 0.15 px off zero in the corners, every group of
+/// them biased the same way (their residuals 0.2-0.8 of their contrast, against 0.05-0.1 on the
+/// wall); past this share every group sits within 0.02 px (docs/results.md). A patch textured
+/// both ways has no such test: its row match must come out level instead.
+const MAX_EDGE_RESIDUAL: f64 = 0.2;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
 /// it sits in one off-row view against where its disparity alone would put it.
@@ -126,6 +134,8 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
                 PatchTexture::Across { normal } => edges && normal.0.abs() >= MIN_ACROSS_X,
             })
             .collect();
+        // An edge or a stripe is kept only where one displacement explains the patch.
+        let fits = |track: &Track, texture: PatchTexture| texture == PatchTexture::Both || track.relative_residual() <= MAX_EDGE_RESIDUAL;
         // The patch of the row view, found in the partner view `baseline d` to the right: `d`.
         // A patch textured both ways is matched freely and must come out level; an edge or a
         // stripe is matched along the row.
@@ -133,7 +143,7 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
             let linear = [[baseline * slope.0, baseline * slope.1], [0.0, 0.0]];
             let guess = (baseline * start, 0.0);
             let along = texture.normal().map(|_| (1.0, 0.0));
-            let found = track_warped(&row_img, partner, (x, y), guess, linear, along, &settings)?.displacement;
+            let found = track_warped(&row_img, partner, (x, y), guess, linear, along, &settings).filter(|t| fits(t, texture))?.displacement;
             (found.1.abs() <= 0.25).then_some(found.0 / baseline)
         };
         let first: Vec<Option<f64>> = patches
@@ -159,7 +169,8 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
                     let b = grid.offset(*view).1;
                     let linear = [[0.0, 0.0], [-b * slope.0, -b * slope.1]];
                     let across = texture.normal();
-                    let track = track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, across, &settings)?;
+                    let track =
+                        track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, across, &settings).filter(|t| fits(t, texture))?;
                     let (dx, dy) = track.displacement;
                     Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across })
                 });
