@@ -16,7 +16,7 @@ use rslf::eval::{EvalReport, evaluate};
 use rslf::io::Scene;
 use rslf::loss::{LossInput, LossRegistry, LossTerm};
 use rslf::pipeline::{Registries, run_with};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// `mean |∂x render - ∂x target| + mean |∂y render - ∂y target|` over a band.
 struct GradientL1;
@@ -74,10 +74,17 @@ struct Outcome {
     log: String,
 }
 
+/// A file of the project. Cargo names the project folder when it runs the example (or its
+/// tests); the compile-time path is the fallback, as a target folder shared between two clones
+/// can hold a binary built in the other one.
+fn project_file(relative: &str) -> PathBuf {
+    std::env::var_os("CARGO_MANIFEST_DIR").map_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")), PathBuf::from).join(relative)
+}
+
 /// Fits the `objects_static` scene at `size` px with `examples/custom_loss.toml` (at `gaussians`
 /// and `iterations`), then again without `gradient_l1`.
 fn demo(size: usize, gaussians: usize, iterations: usize) -> Outcome {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/custom_loss.toml");
+    let path = project_file("examples/custom_loss.toml");
     let mut config = Config::read(&path).expect("examples/custom_loss.toml parses");
     config.stage1.gaussians = gaussians;
     config.stage1.iterations = iterations;

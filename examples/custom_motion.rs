@@ -19,7 +19,7 @@ use rslf::io::{MotionRecord, Scene};
 use rslf::model::motion::{MotionModel, MotionRegistry, ParamKind, Quantity, scale_rows};
 use rslf::pipeline::{Registries, run_with};
 use rslf::synth::{GenerateOptions, SceneDescription, generate};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// `P(t) = R(t (ωx, ωy, 0)) P0`: parameters `[ωx, ωy]` (rad/s).
 struct PanTilt;
@@ -79,8 +79,15 @@ struct Fitted {
     omega: [f64; 3],
 }
 
+/// A file of the project. Cargo names the project folder when it runs the example (or its
+/// tests); the compile-time path is the fallback, as a target folder shared between two clones
+/// can hold a binary built in the other one.
+fn project_file(relative: &str) -> PathBuf {
+    std::env::var_os("CARGO_MANIFEST_DIR").map_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")), PathBuf::from).join(relative)
+}
+
 fn fit(scene: &Scene, model: &str, gaussians: usize, out: &Path) -> Fitted {
-    let mut config = Config::read(&Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/constant_velocity.toml")).expect("config parses");
+    let mut config = Config::read(&project_file("configs/constant_velocity.toml")).expect("config parses");
     config.motion.model = model.into();
     config.stage1.gaussians = gaussians;
     config.stage1.band_height = 32;

@@ -134,7 +134,7 @@ fn the_suite_spans_static_slow_and_fast_motions_of_the_intended_size() {
 fn the_readme_suite_table_is_what_the_generator_lists() {
     let (ok, stdout, stderr) = rslf(&["generate", "--suite", "--list"]);
     assert!(ok, "{stderr}");
-    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let readme = std::fs::read_to_string(common::project_path("README.md")).unwrap();
     let listed: Vec<String> = stdout
         .lines()
         .skip(1)
@@ -166,7 +166,8 @@ fn generate_refuses_bad_descriptions_and_existing_folders_cleanly() {
     assert_eq!(stderr.matches("panicked").count(), 0);
     assert!(!out.exists());
 
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml");
+    let scene_path = common::project_path("configs/scenes/objects.toml");
+    let scene = scene_path.to_str().expect("the project path is UTF-8");
     std::fs::create_dir(&out).unwrap();
     let (ok, _, stderr) = rslf(&["generate", scene, "--out", out.to_str().unwrap(), "--size", "16"]);
     assert!(!ok && stderr.contains("already exists"), "{stderr}");

@@ -48,8 +48,7 @@ fn stage_1_takes_cotton_central_row_then_its_central_column_nearest_first() {
 
 #[test]
 fn the_shipped_config_fits_the_central_column_only_without_a_rolling_shutter() {
-    let config =
-        rslf::config::Config::read(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/constant_velocity.toml"))).unwrap();
+    let config = rslf::config::Config::read(&common::project_path("configs/constant_velocity.toml")).unwrap();
     let s1 = &config.stage1;
     assert_eq!(s1.column_views, None, "the shipped config leaves the choice to the capture");
     // Cotton is a global-shutter capture: no motion bends its column, so the fit takes as many

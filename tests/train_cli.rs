@@ -54,7 +54,7 @@ fn train_recovers_the_disparity_of_a_plane_and_writes_a_format_result() {
 
 #[test]
 fn the_shipped_configs_parse() {
-    for entry in std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/configs")).unwrap() {
+    for entry in std::fs::read_dir(common::project_path("configs")).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             rslf::config::Config::read(&path).unwrap_or_else(|e| panic!("{e}"));

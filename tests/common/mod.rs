@@ -5,13 +5,23 @@ use rslf::geometry::ViewId;
 use rslf::io::{Raster, Scene, SceneParameters, view_file_name, write_png};
 use std::path::{Path, PathBuf};
 
+/// The project folder. Cargo names it at run time; the path baked in at compile time is only the
+/// fallback, because a target folder shared between two clones of the project (as `.ci/run`'s
+/// is) can hand one clone test binaries that another compiled, with that clone's path inside.
+pub fn project_dir() -> PathBuf {
+    std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+}
+
+/// A file or folder of the project, by its path relative to the project folder.
+pub fn project_path(relative: &str) -> PathBuf {
+    project_dir().join(relative)
+}
+
 /// A folder of the HCI benchmark scenes (`../shared/data/hci` beside the project, or
 /// `$RSLF_HCI_DIR`). Panics with a clear message when it is not there: these tests are the
 /// project's proof of its conventions on real data and must not be skipped silently.
 pub fn hci(scene: &str) -> PathBuf {
-    let root = std::env::var_os("RSLF_HCI_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/hci"));
+    let root = std::env::var_os("RSLF_HCI_DIR").map(PathBuf::from).unwrap_or_else(|| project_path("../shared/data/hci"));
     let dir = root.join(scene);
     assert!(dir.is_dir(), "HCI scene not found at {} (set RSLF_HCI_DIR to the folder holding antinous/, cotton/, dino/)", dir.display());
     dir
@@ -118,7 +128,7 @@ pub fn rslf(args: &[&str]) -> (bool, String, String) {
 /// Runs the `rslf` binary from the project folder with extra environment variables.
 pub fn rslf_with_env(args: &[&str], env: &[(&str, &Path)]) -> (bool, String, String) {
     let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_rslf"));
-    cmd.args(args).current_dir(env!("CARGO_MANIFEST_DIR"));
+    cmd.args(args).current_dir(project_dir());
     for (k, v) in env {
         cmd.env(k, v);
     }
@@ -150,7 +160,7 @@ pub fn warp_error(scene: &Scene, disparity: &Raster, view: ViewId, sign: f64, bo
 
 /// `configs/scenes/objects.toml` at 64 x 64 px and one ray per pixel: small and quick to render.
 pub fn small_objects_description() -> String {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/scenes/objects.toml")).unwrap();
+    let text = std::fs::read_to_string(project_path("configs/scenes/objects.toml")).unwrap();
     let small = |line: &str| match line {
         l if l.starts_with("size = ") => "size = [64, 64]".to_string(),
         l if l.starts_with("supersampling = ") => "supersampling = 1".to_string(),
