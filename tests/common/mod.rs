@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 /// fallback, because a target folder shared between two clones of the project (as `.ci/run`'s
 /// is) can hand one clone test binaries that another compiled, with that clone's path inside.
 pub fn project_dir() -> PathBuf {
-    std::env::var_os("CARGO_MANIFEST_DIR").map(PathBuf::from).unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+    std::env::var_os("CARGO_MANIFEST_DIR").map_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")), PathBuf::from)
 }
 
 /// A file or folder of the project, by its path relative to the project folder.
