@@ -53,11 +53,13 @@ fn train_recovers_the_disparity_of_a_plane_and_writes_a_format_result() {
 }
 
 #[test]
-fn the_shipped_configs_parse() {
+fn the_shipped_configs_parse_and_name_only_built_in_terms_and_models() {
+    let registries = rslf::pipeline::Registries::default();
     for entry in std::fs::read_dir(common::project_path("configs")).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
-            rslf::config::Config::read(&path).unwrap_or_else(|e| panic!("{e}"));
+            let config = rslf::config::Config::read(&path).unwrap_or_else(|e| panic!("{e}"));
+            registries.check(&config).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         }
     }
 }

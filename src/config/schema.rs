@@ -290,7 +290,7 @@ impl Default for RenderConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LossConfig {
-    /// Registry name: `l1`, `l2`, `dssim`, `smoothness`, `motion_prior`, ...
+    /// Registry name: `l1`, `l2`, `dssim`, `smoothness`, `motion_prior`, `motion_smoothness`, ...
     pub kind: String,
     /// Weight of the term in the total loss.
     #[serde(default = "one")]

@@ -9,6 +9,7 @@ mod dssim;
 mod l1;
 mod l2;
 mod motion_prior;
+mod motion_smoothness;
 mod registry;
 mod smoothness;
 #[cfg(test)]
@@ -18,11 +19,14 @@ pub use dssim::DSsim;
 pub use l1::L1;
 pub use l2::L2;
 pub use motion_prior::MotionPrior;
+pub use motion_smoothness::MotionSmoothness;
 pub use registry::{LossRegistry, UnknownLoss, WeightedLoss, WeightedLosses};
 pub use smoothness::EdgeAwareSmoothness;
 
+use crate::model::motion::MotionModel;
 use crate::render::RenderOutput;
 use burn::tensor::Tensor;
+use std::fmt;
 
 /// What a loss term may look at: one band of `rows x width` pixels of one view.
 #[derive(Debug, Clone)]
@@ -35,10 +39,25 @@ pub struct LossInput<'a> {
     pub rows: usize,
     /// Pixels per row.
     pub width: usize,
-    /// The motion parameters being fitted, scaled so that one unit moves the image by about one
-    /// pixel over the read-out (`None` in stages without motion, and in stage 2's Newton steps
+    /// The motion being fitted (`None` in stages without motion, and in stage 2's Newton steps
     /// when the measured cues are in their objective).
-    pub motion: Option<&'a Tensor<1>>,
+    pub motion: Option<MotionInput<'a>>,
+}
+
+/// The motion a loss term may look at: its parameters and the model that reads them.
+#[derive(Clone, Copy)]
+pub struct MotionInput<'a> {
+    /// The parameter vector `[P]`, scaled so that one unit moves the image by about one pixel
+    /// over the read-out.
+    pub scaled: &'a Tensor<1>,
+    /// The motion model the parameters belong to.
+    pub model: &'a dyn MotionModel,
+}
+
+impl fmt::Debug for MotionInput<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("MotionInput").field("scaled", self.scaled).field("model", &self.model.name()).finish()
+    }
 }
 
 /// One term of the objective.

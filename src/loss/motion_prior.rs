@@ -16,6 +16,6 @@ impl LossTerm for MotionPrior {
     }
 
     fn evaluate(&self, input: &LossInput) -> Option<Tensor<1>> {
-        input.motion.map(|x| (x.clone() * x.clone()).mean())
+        input.motion.map(|m| (m.scaled.clone() * m.scaled.clone()).mean())
     }
 }

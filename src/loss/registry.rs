@@ -1,6 +1,6 @@
 //! Loss terms by name, and the weighted sum a config asks for.
 
-use super::{DSsim, EdgeAwareSmoothness, L1, L2, LossInput, LossTerm, MotionPrior};
+use super::{DSsim, EdgeAwareSmoothness, L1, L2, LossInput, LossTerm, MotionPrior, MotionSmoothness};
 use crate::config::LossConfig;
 use burn::tensor::Tensor;
 use std::collections::BTreeMap;
@@ -26,7 +26,8 @@ pub struct LossRegistry {
 }
 
 impl Default for LossRegistry {
-    /// The built-in terms: `l1`, `l2`, `dssim`, `smoothness`, `motion_prior`.
+    /// The built-in terms: `l1`, `l2`, `dssim`, `smoothness`, `motion_prior`,
+    /// `motion_smoothness`.
     fn default() -> Self {
         Self { terms: BTreeMap::new() }
             .register("l1", || Box::new(L1))
@@ -34,6 +35,7 @@ impl Default for LossRegistry {
             .register("dssim", || Box::new(DSsim))
             .register("smoothness", || Box::new(EdgeAwareSmoothness))
             .register("motion_prior", || Box::new(MotionPrior))
+            .register("motion_smoothness", || Box::new(MotionSmoothness))
     }
 }
 

@@ -10,7 +10,7 @@ use super::visibility::{explained_mask_moving, masked};
 use crate::device::host_values;
 use crate::geometry::{Camera, TensorCamera, ViewId};
 use crate::io::{MotionRecord, Raster, Scene};
-use crate::loss::{LossInput, WeightedLosses};
+use crate::loss::{LossInput, MotionInput, WeightedLosses};
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionParams, ScaleContext, parameter_scales};
 use crate::optim::{GroupPlan, MeanLoss, NewtonReport, NewtonSettings, Plan, Schedule, Stage, StepReport, newton_minimise, optimise};
@@ -232,7 +232,7 @@ pub fn fit_stage2(
                         (Some(weights), true) => masked(out, target, weights[b].clone()),
                         _ => (out, target),
                     };
-                    let motion = pass.prior.then_some(scaled);
+                    let motion = pass.prior.then_some(MotionInput { scaled, model });
                     band_loss.add(losses.evaluate(&LossInput { rendered: &out, target: &target, rows: rows.len(), width: w, motion }));
                 }
                 // A band counts once; with two passes, their losses are summed.

@@ -70,6 +70,17 @@ pub trait MotionModel: Send + Sync {
 
     /// The parameter vector of a motion file, when this model can express it exactly.
     fn parameters_of(&self, record: &MotionRecord) -> Option<Vec<f64>>;
+
+    /// How far a motion is from the smoothest this model can express, as residuals that vanish
+    /// on those (the `motion_smoothness` loss term's `mean r²`): `piecewise_constant`'s second
+    /// differences of its segments' rates, zero when the rates change linearly in time. `scaled`
+    /// is the scaled parameter vector `[P]`; a residual combines entries of one [`ParamKind`]
+    /// only, so it reads in that kind's scaled units. `None` (the default): the model has no
+    /// freedom beyond its smoothest motions.
+    fn roughness(&self, scaled: Tensor<1>) -> Option<Tensor<1>> {
+        let _ = scaled;
+        None
+    }
 }
 
 /// The trainable motion: a parameter vector in scaled units (one unit ≈ one pixel of image

@@ -79,6 +79,19 @@ impl MotionModel for PiecewiseConstant {
         }
     }
 
+    /// The rates' second difference across segments, `x_{k+1} - 2 x_k + x_{k-1}` for each of
+    /// the six rates: zero when they change linearly from segment to segment (a constant
+    /// acceleration), `6 (K - 2)` residuals; `None` with fewer than three segments.
+    fn roughness(&self, scaled: Tensor<1>) -> Option<Tensor<1>> {
+        let k = self.segments;
+        if k < 3 {
+            return None;
+        }
+        let rates = scaled.reshape([k, 6]);
+        let second = rates.clone().narrow(0, 2, k - 2) - rates.clone().narrow(0, 1, k - 2) * 2.0 + rates.narrow(0, 0, k - 2);
+        Some(second.reshape([6 * (k - 2)]))
+    }
+
     fn parameters_of(&self, record: &MotionRecord) -> Option<Vec<f64>> {
         match record {
             MotionRecord::PiecewiseConstant { omega_rad_s, velocity_m_s } if omega_rad_s.len() == self.segments => {
