@@ -1,7 +1,7 @@
 //! Properties of the built-in loss terms on small hand-made bands.
 
 use super::*;
-use crate::model::motion::{ConstantVelocity, PiecewiseConstant};
+use crate::model::motion::{ConstantVelocity, MotionModel, PiecewiseConstant};
 use crate::render::RenderOutput;
 use burn::tensor::{Device, Tensor, TensorData};
 
@@ -85,9 +85,7 @@ fn motion_smoothness_is_free_for_rates_that_change_linearly_and_costs_a_jolt() {
     let device = Device::flex();
     let t = band(vec![0.0; 4], 2, 2, &device);
     let out = output(t.clone(), vec![0.0; 4], &device);
-    let eval = |m: &Tensor<1>, model: &dyn crate::model::motion::MotionModel| {
-        value(&MotionSmoothness, &out, &t, 2, 2, Some(MotionInput { scaled: m, model }))
-    };
+    let eval = |m: &Tensor<1>, model: &dyn MotionModel| value(&MotionSmoothness, &out, &t, 2, 2, Some(MotionInput { scaled: m, model }));
     let (k, model) = (5, piecewise(5));
     // Rates on a line in time (a constant acceleration), each entry its own line: no cost.
     let ramp = segment_rates(k, |j, e| 0.3 * e as f32 - 1.0 + (e as f32 - 2.5) * 0.7 * j as f32, &device);
