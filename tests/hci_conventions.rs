@@ -156,3 +156,36 @@ fn the_disocclusion_mask_of_antinous_corners_leaves_out_what_the_central_view_do
         assert!(left_out_error > 8.0 * kept_error, "view {view:?}: error {kept_error} kept vs {left_out_error} left out");
     }
 }
+
+#[test]
+fn stage_2_takes_cottons_corners_and_without_them_the_outermost_views_of_each_quadrant() {
+    use rslf::config::ViewSelection::{AllOffRow, Corners};
+    use rslf::pipeline::stage2_views;
+    let source = hci("cotton");
+    let scene = Scene::load(&source).unwrap();
+    assert_eq!(stage2_views(&scene, Corners), scene.grid.corners().to_vec());
+    assert_eq!(stage2_views(&scene, AllOffRow).len(), 24, "33 views less the 9 of the central row");
+    // Cotton copied without some of its views: `keep(row, col)` says which stay.
+    let without = |keep: &dyn Fn(usize, usize) -> bool| {
+        let dir = common::tempdir();
+        for entry in std::fs::read_dir(&source).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_str().unwrap().to_string();
+            let index = name.strip_prefix("input_Cam").and_then(|n| n.strip_suffix(".png")).map(|n| n.parse::<usize>().unwrap());
+            if index.is_none_or(|i| keep(i / 9, i % 9)) {
+                std::fs::copy(&path, dir.path().join(&name)).unwrap();
+            }
+        }
+        let scene = Scene::load(dir.path()).unwrap();
+        (dir, scene)
+    };
+    let v = |row, col| ViewId { row, col };
+    // Without the corners (as a plenoptic camera's vignetted corner views often are), the next
+    // views along its diagonals stand in.
+    let (_dir, cornerless) = without(&|r, c| !((r == 0 || r == 8) && (c == 0 || c == 8)));
+    assert_eq!(cornerless.present_views().len(), 29);
+    assert_eq!(stage2_views(&cornerless, Corners), vec![v(1, 1), v(1, 7), v(7, 1), v(7, 7)]);
+    // The central row and column alone: no view in any quadrant, so the column's eight are taken.
+    let (_dir, cross) = without(&|r, c| r == 4 || c == 4);
+    assert_eq!(stage2_views(&cross, Corners), (0..9).filter(|&r| r != 4).map(|r| v(r, 4)).collect::<Vec<_>>());
+}

@@ -53,6 +53,31 @@ fn train_recovers_the_disparity_of_a_plane_and_writes_a_format_result() {
 }
 
 #[test]
+fn a_rolling_shutter_scene_of_the_central_row_alone_is_not_compensated_and_says_why() {
+    // The central row's views read each row at the same instant: they hold no trace of motion,
+    // so no motion may be reported.
+    let root = common::tempdir();
+    let scene = root.path().join("row");
+    let (w, h, n) = (48, 32, 5);
+    write_plane_scene(&scene, w, h, n, 0.5, |i| i / n == n / 2);
+    let p = rslf::io::SceneParameters { line_time_s: Some(1e-4), ..params(w, h, n) };
+    p.write(&scene.join("parameters.cfg")).unwrap();
+    let config = root.path().join("row.toml");
+    std::fs::write(
+        &config,
+        format!("scene = {:?}\n[stage1]\ngaussians = 500\niterations = 5\ndisparity_step = 0.1\n", scene.to_str().unwrap()),
+    )
+    .unwrap();
+    let (out, models) = (root.path().join("result"), root.path().join("models"));
+    let (ok, stdout, stderr) =
+        rslf(&["train", config.to_str().unwrap(), "--out", out.to_str().unwrap(), "--models", models.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("stage 2 (motion): skipped, the scene has no view off the central row"), "{stdout}");
+    assert!(out.join("disparity.pfm").exists() && out.join("central.png").exists());
+    assert!(!out.join("motion.toml").exists(), "no motion can be estimated from the central row");
+}
+
+#[test]
 fn the_shipped_configs_parse_and_name_only_built_in_terms_and_models() {
     let registries = rslf::pipeline::Registries::default();
     for entry in std::fs::read_dir(common::project_path("configs")).unwrap() {

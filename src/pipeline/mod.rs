@@ -129,12 +129,31 @@ impl Registries {
 
 /// The views stage 2 compares against: the four corners or every present view off the
 /// central row.
+///
+/// `Corners` takes, in each quadrant of the grid (off the central row and column), the present
+/// view farthest from the central row, and of those the one farthest from the central column:
+/// the corner itself when it is there (the paper's choice). A capture that lacks the corners
+/// (a plenoptic camera's vignetted corner views are often dropped) gets the outermost views it
+/// has; the vertical offset comes first because it alone sets the read-out delay the motion
+/// shows in. With no view in any quadrant (only the central row and column), every view off
+/// the central row is taken.
 pub fn stage2_views(scene: &Scene, selection: ViewSelection) -> Vec<ViewId> {
-    let centre_row = scene.central_id().row;
-    match selection {
-        ViewSelection::Corners => scene.grid.corners().into_iter().filter(|&v| scene.view(v).is_some()).collect(),
-        ViewSelection::AllOffRow => scene.present_views().into_iter().filter(|v| v.row != centre_row).collect(),
+    let centre = scene.central_id();
+    let off_row: Vec<ViewId> = scene.present_views().into_iter().filter(|v| v.row != centre.row).collect();
+    if selection == ViewSelection::AllOffRow {
+        return off_row;
     }
+    let corners: Vec<ViewId> = [(false, false), (false, true), (true, false), (true, true)]
+        .into_iter()
+        .filter_map(|(below, right)| {
+            off_row
+                .iter()
+                .filter(|v| v.col != centre.col && (v.row > centre.row) == below && (v.col > centre.col) == right)
+                .max_by_key(|v| (v.row.abs_diff(centre.row), v.col.abs_diff(centre.col)))
+                .copied()
+        })
+        .collect();
+    if corners.is_empty() { off_row } else { corners }
 }
 
 /// The read-out timing a config asks for.
@@ -225,6 +244,16 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
         Some(path) => Some(MotionRecord::read(path)?),
         None => None,
     };
+    // The motion shows only in views off the central row: without one it cannot be estimated,
+    // and a given `initial_motion` is used as it is.
+    let observable = !stage2_views(scene, ViewSelection::AllOffRow).is_empty();
+    let unobserved;
+    let config = if observable || config.stage2.iterations == 0 {
+        config
+    } else {
+        unobserved = Config { stage2: crate::config::Stage2Config { iterations: 0, ..config.stage2.clone() }, ..config.clone() };
+        &unobserved
+    };
     let stage2_ready = scene.is_rolling_shutter() && (config.stage2.iterations > 0 || initial_motion.is_some());
     let (central, disparity, motion, points, gaussians) = match (stage2_ready, &camera, &motion_model) {
         (true, Some(cam), Some(model)) => {
@@ -238,6 +267,9 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
                 })?,
                 None => vec![0.0; model.parameters().len()],
             };
+            if !observable {
+                log.lines.push("stage 2 (motion): the scene has no view off the central row to fit a motion to; stage2.initial_motion is used as given".into());
+            }
             // The stage-1 geometry the disocclusion masks come from, rendered only when they are asked for.
             let stage1_disparity = config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
             let fitted = stage2(
@@ -260,7 +292,12 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
             (central, disparity, Some(model.record(&fitted.parameters)), Some(PointCloud::of_shape(&shape)), gaussians)
         }
         _ => {
-            if scene.is_rolling_shutter() {
+            if scene.is_rolling_shutter() && !observable {
+                log.lines.push(
+                    "stage 2 (motion): skipped, the scene has no view off the central row, whose views are read in step and so show no motion; the result is not compensated"
+                        .into(),
+                );
+            } else if scene.is_rolling_shutter() {
                 log.lines.push("stage 2 (motion): skipped, stage2.iterations = 0; the result is not compensated".into());
             } else if camera.is_none() {
                 log.lines.push("stage 2 (motion): skipped, no parameters.cfg (no camera, so no motion or depth)".into());
@@ -397,6 +434,13 @@ fn stage2(
             .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, device))
     };
     let mut views = stage2_views(scene, s.views);
+    if s.views == ViewSelection::Corners && views != scene.grid.corners() {
+        let names: Vec<String> = views.iter().map(|&v| scene.grid.index(v).to_string()).collect();
+        log.lines.push(format!(
+            "stage 2 views: the grid's four corners are not all present; views {} stand in for them (each quadrant's outermost)",
+            names.join(", ")
+        ));
+    }
     let refine = (s.refine_gaussians > 0.0).then(|| {
         let (k, s1) = (s.refine_gaussians, &config.stage1);
         views.extend(stage1_views(scene, s1.views, column_views(config, scene)));
