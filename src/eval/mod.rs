@@ -85,11 +85,11 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
         (None, Some(d), Some(cam)) => Some((depth_from_disparity(cam, d), "gt_disp_lowres.pfm + parameters.cfg")),
         _ => None,
     };
-    let depth = match (est_z, gt_z) {
+    let depth = match (est_z, &gt_z) {
         (Some((e, es)), Some((t, ts))) => Some(DepthReport {
-            metrics: depth_metrics(&e, &t, &evaluation_region(w, h, mask, 0)),
+            metrics: depth_metrics(&e, t, &evaluation_region(w, h, mask, 0)),
             estimate_source: es.into(),
-            truth_source: ts.into(),
+            truth_source: (*ts).into(),
         }),
         (_, None) if camera.is_none() => {
             notes.push("no parameters.cfg in the scene: depth not evaluated (disparity only)".into());
@@ -107,20 +107,24 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
         _ => None,
     };
 
+    // The motion's image-space error needs the scene's t = 0 points: the true depth, or the
+    // true disparity through the camera.
     let motion = match (&est_motion, &gt.motion) {
-        (Some(e), Some(t)) => Some(MotionReport {
-            estimated_model: e.model_name().into(),
-            true_model: t.model_name().into(),
-            parameters: motion_parameter_errors(e, t),
-            image: match (&camera, &gt.depth) {
-                (Some(cam), Some(z)) => image_motion_error(cam, e, t, z, MOTION_POINT_STRIDE),
-                _ => None,
-            },
-            observability: match (&camera, &gt.depth) {
-                (Some(cam), Some(z)) => observability(cam, t, z, OBSERVABILITY_POINT_STRIDE),
-                _ => None,
-            },
-        }),
+        (Some(e), Some(t)) => {
+            let points = camera.as_ref().zip(gt_z.as_ref());
+            match points {
+                Some((_, (_, source))) if gt.depth.is_none() => notes.push(format!("motion: the t = 0 points from {source}")),
+                None => notes.push("motion: no ground-truth depth or disparity with parameters.cfg, so no image-space error".into()),
+                _ => {}
+            }
+            Some(MotionReport {
+                estimated_model: e.model_name().into(),
+                true_model: t.model_name().into(),
+                parameters: motion_parameter_errors(e, t),
+                image: points.and_then(|(cam, (z, _))| image_motion_error(cam, e, t, z, MOTION_POINT_STRIDE)),
+                observability: points.and_then(|(cam, (z, _))| observability(cam, t, z, OBSERVABILITY_POINT_STRIDE)),
+            })
+        }
         (None, Some(_)) => {
             notes.push("no motion.toml in the result: motion not evaluated".into());
             None

@@ -1,0 +1,45 @@
+//! `rslf eval` end to end on a generated scene: the motion's image-space error.
+
+mod common;
+
+use common::{rslf, tempdir};
+use rslf::io::MotionRecord;
+use rslf::synth::{GenerateOptions, SceneDescription, generate};
+use std::path::Path;
+
+/// The image-space RMS error (px) `rslf eval` prints, and its notes.
+fn image_error(scene: &Path, result: &Path) -> (Option<f64>, String) {
+    let (ok, stdout, stderr) = rslf(&["eval", "--scene", scene.to_str().unwrap(), "--result", result.to_str().unwrap(), "--no-write"]);
+    assert!(ok, "{stderr}");
+    let error = stdout.lines().find_map(|l| l.split("image-space RMS error ").nth(1)?.split(' ').next()?.parse().ok());
+    (error, stdout)
+}
+
+#[test]
+fn the_image_space_motion_error_takes_the_true_disparity_where_the_true_depth_is_missing() {
+    let dir = tempdir();
+    let scene = dir.path().join("scene");
+    let truth = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.3, 0.0], velocity_m_s: [1.0, 0.0, 0.0] };
+    let mut desc: SceneDescription = toml::from_str(&common::small_objects_description()).unwrap();
+    desc.camera.num_cams = 5;
+    desc.motion = Some(toml::from_str(&truth.to_toml_string()).unwrap());
+    generate(&desc, &GenerateOptions { size: None, seed: 0 }, |_, _| {}).unwrap().write(&scene, false).unwrap();
+    // A result whose motion is half the truth.
+    let result = dir.path().join("result");
+    std::fs::create_dir_all(&result).unwrap();
+    let half = MotionRecord::ConstantVelocity { omega_rad_s: [0.0, 0.15, 0.0], velocity_m_s: [0.5, 0.0, 0.0] };
+    std::fs::write(result.join("motion.toml"), half.to_toml_string()).unwrap();
+
+    let (from_depth, stdout) = image_error(&scene, &result);
+    let from_depth = from_depth.unwrap_or_else(|| panic!("no image-space error: {stdout}"));
+    assert!(from_depth > 0.1, "half the motion is off by half its shift: {stdout}");
+    std::fs::remove_file(scene.join("gt_depth_lowres.pfm")).unwrap();
+    let (from_disparity, stdout) = image_error(&scene, &result);
+    let from_disparity = from_disparity.unwrap_or_else(|| panic!("no image-space error without gt_depth_lowres.pfm: {stdout}"));
+    // The generator writes the disparity from the depth by the camera model: the same points.
+    assert!((from_disparity - from_depth).abs() < 1e-3, "{from_disparity} px from the disparity, {from_depth} px from the depth");
+    assert!(stdout.contains("the t = 0 points from gt_disp_lowres.pfm + parameters.cfg"), "{stdout}");
+    std::fs::remove_file(scene.join("gt_disp_lowres.pfm")).unwrap();
+    let (none, stdout) = image_error(&scene, &result);
+    assert!(none.is_none() && stdout.contains("no ground-truth depth or disparity"), "{stdout}");
+}
