@@ -177,3 +177,52 @@ fn generate_refuses_bad_descriptions_and_existing_folders_cleanly() {
     let written = Scene::load(&out).unwrap();
     assert_eq!((written.width(), written.height(), written.present_views().len()), (24, 16, 81));
 }
+
+#[test]
+fn the_motion_model_scenes_are_objects_under_a_motion_of_their_own_model() {
+    let objects = SceneDescription::read(&common::project_path("configs/scenes/objects.toml")).unwrap();
+    for (file, model) in
+        [("objects_accel", "constant_acceleration"), ("objects_piecewise", "piecewise_constant"), ("objects_jolt", "piecewise_constant")]
+    {
+        let scene = SceneDescription::read(&common::project_path(&format!("configs/scenes/{file}.toml"))).unwrap();
+        assert_eq!(scene.name, file);
+        assert_eq!((&scene.camera, &scene.render, &scene.objects), (&objects.camera, &objects.render, &objects.objects), "{file}");
+        let motion = scene.motion().unwrap();
+        assert_eq!(motion.model_name(), model, "{file}");
+        assert_ne!(motion, MotionRecord::zero());
+    }
+}
+
+#[test]
+fn a_description_on_a_base_overrides_camera_keys_one_by_one_and_replaces_the_rest() {
+    let dir = tempdir();
+    let write = |name: &str, text: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    write(
+        "base.toml",
+        "name = \"base\"\n[camera]\nnum_cams = 5\nsize = [32, 24]\n[motion]\nmodel = \"constant_velocity\"\nomega_rad_s = [0, 1, 0]\nvelocity_m_s = [0, 0, 0]\n[[object]]\nshape = { kind = \"sphere\", radius = 0.5 }\nposition = [0, 0, 4]\ntexture = { kind = \"flat\", color = [0.5, 0.5, 0.5] }\n",
+    );
+    let derived = write("derived.toml", "base = \"base.toml\"\nname = \"derived\"\n[camera]\nsize = [16, 16]\n");
+    let scene = SceneDescription::read(&derived).unwrap();
+    assert_eq!((scene.name.as_str(), scene.camera.size, scene.camera.num_cams, scene.objects.len()), ("derived", [16, 16], 5, 1));
+    assert_eq!(scene.motion().unwrap().model_name(), "constant_velocity");
+    // A motion of another model replaces the base's whole: none of its keys are left over.
+    let piecewise = write(
+        "piecewise.toml",
+        "base = \"derived.toml\"\n[motion]\nmodel = \"piecewise_constant\"\nsegments = 1\nomega_rad_s = [[0, 0, 1]]\nvelocity_m_s = [[0, 0, 0]]\n",
+    );
+    let scene = SceneDescription::read(&piecewise).unwrap();
+    assert_eq!((scene.name.as_str(), scene.camera.size), ("derived", [16, 16]));
+    assert_eq!(scene.motion().unwrap().model_name(), "piecewise_constant");
+    // A cycle, a missing base and a base that is not a path are errors naming the file.
+    let cycle = write("cycle.toml", "base = \"cycle.toml\"\nname = \"c\"\n");
+    let missing = write("missing.toml", "base = \"nowhere.toml\"\n");
+    let number = write("number.toml", "base = 3\n");
+    for (path, problem) in [(&cycle, "a cycle?"), (&missing, "nowhere.toml"), (&number, "`base` must be the path")] {
+        let error = SceneDescription::read(path).unwrap_err().to_string();
+        assert!(error.contains(problem), "{error}");
+    }
+}

@@ -117,6 +117,42 @@ fn grey() -> Rgb {
     [0.5; 3]
 }
 
+/// How many `base` descriptions one file may stand on, one on another (more is taken for a cycle).
+const MAX_BASES: usize = 8;
+
+/// The TOML table of a description's text; a syntax error names the line.
+fn parse_table(text: &str, path: &Path) -> IoResult<toml::Table> {
+    text.parse::<toml::Table>().map_err(|e| {
+        let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let at = line.map_or(String::new(), |l| format!("line {l}: "));
+        IoError::new(path, format!("{at}{}", e.message().trim().replace('\n', " ")))
+    })
+}
+
+/// `table` (read from `path`) over its `base` description, and that over its own, `depth` bases
+/// deep so far (see [`SceneDescription::read`]).
+fn with_bases(mut table: toml::Table, path: &Path, depth: usize) -> IoResult<toml::Table> {
+    let Some(base) = table.remove("base") else { return Ok(table) };
+    let toml::Value::String(base) = base else {
+        return Err(IoError::new(path, "`base` must be the path of another scene description, relative to this file"));
+    };
+    if depth >= MAX_BASES {
+        return Err(IoError::new(path, format!("more than {MAX_BASES} `base` descriptions, one on another: a cycle?")));
+    }
+    let base_path = path.parent().unwrap_or(Path::new(".")).join(base);
+    let text = std::fs::read_to_string(&base_path).map_err(|e| IoError::os(&base_path, e))?;
+    let mut merged = with_bases(parse_table(&text, &base_path)?, &base_path, depth + 1)?;
+    for (key, value) in table {
+        match (merged.get_mut(&key), value) {
+            (Some(toml::Value::Table(into)), toml::Value::Table(over)) if key == "camera" || key == "render" => into.extend(over),
+            (_, value) => {
+                merged.insert(key, value);
+            }
+        }
+    }
+    Ok(merged)
+}
+
 impl SceneDescription {
     /// Parses and checks a description; `path` names the file in errors.
     pub fn parse(text: &str, path: &Path) -> IoResult<Self> {
@@ -129,10 +165,20 @@ impl SceneDescription {
         Ok(desc)
     }
 
-    /// Reads a description file.
+    /// Reads a description file. A file with `base = "other.toml"` (a path relative to the
+    /// file's folder) starts from that description: its `[camera]` and `[render]` keys override
+    /// the base's one by one, and every other key (`name`, `[motion]`, `background`, the
+    /// `[[object]]` list) replaces the base's whole.
     pub fn read(path: &Path) -> IoResult<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| IoError::os(path, e))?;
-        Self::parse(&text, path)
+        let table = parse_table(&text, path)?;
+        if !table.contains_key("base") {
+            return Self::parse(&text, path);
+        }
+        let merged = with_bases(table, path, 0)?;
+        let desc = Self::deserialize(merged).map_err(|e| IoError::new(path, e.message().trim().replace('\n', " ")))?;
+        desc.validate().map_err(|p| IoError::new(path, p))?;
+        Ok(desc)
     }
 
     /// The motion; zero when none is given.
