@@ -8,7 +8,7 @@ use rslf::config::MotionConfig;
 use rslf::geometry::{Camera, Pose, TensorCamera, ViewGrid, pose_at};
 use rslf::io::MotionRecord;
 use rslf::model::GaussianSet;
-use rslf::model::motion::{MotionModel, MotionRegistry, MotionSetup};
+use rslf::model::motion::{MotionModel, MotionRegistry, MotionSetup, Tabulated};
 use rslf::render::{RenderSettings, RsTiming, StaticShape, render_rolling_shutter};
 
 const READOUT: (f64, f64) = (-0.02, 0.02);
@@ -75,6 +75,77 @@ fn tensor_poses_follow_the_host_laws_of_every_model() {
                 }
                 let got = tr[i * 3 + a] as f64;
                 assert!((got - expected.translation[a]).abs() < 2e-6, "{} t={time} T[{a}] {got} vs {}", m.name(), expected.translation[a]);
+            }
+        }
+    }
+}
+
+/// The times of the table tests: inside the read-out, beside the piecewise models' segment
+/// boundaries (-0.01, 0 and 0.01 with four segments, on knots of the table; ±0.00667 with three,
+/// inside an interval of it), and just beyond the table at both ends (half a millisecond).
+const TABLE_TIMES: [f64; 13] = [-0.0255, -0.02, -0.0101, -0.00999, -0.00668, -0.0031, 0.0, 0.00417, 0.00668, 0.0099, 0.0102, 0.019, 0.0254];
+
+/// The piecewise models' segment boundaries, all of them.
+const BOUNDARIES: [f64; 5] = [-0.01, -0.02 / 3.0, 0.0, 0.02 / 3.0, 0.01];
+
+/// `Σ w · (R, T)` of the poses at `times` for fixed weights: one number that every entry of
+/// every pose moves.
+fn pose_sum(m: &dyn MotionModel, p: Tensor<1>, times: Tensor<1>) -> Tensor<1> {
+    let poses = m.poses(p, times);
+    let n = poses.translation.dims()[0];
+    let device = poses.translation.device();
+    let weights = |k: usize| {
+        Tensor::<1>::from_data(TensorData::new((0..k).map(|i| ((i * 7 % 13) as f32 - 6.0) / 6.0).collect::<Vec<_>>(), [k]), &device)
+    };
+    (poses.rotation.reshape([n * 9]) * weights(n * 9)).sum() + (poses.translation.reshape([n * 3]) * weights(n * 3)).sum()
+}
+
+#[test]
+fn a_tabulated_model_gives_the_poses_and_gradients_of_the_model_it_reads() {
+    let device = Device::flex().autodiff();
+    // Four samples per row of a 256-row read-out of 0.04 s, 0.005 s beyond it each side.
+    let step = (READOUT.1 - READOUT.0) / (4.0 * 256.0);
+    let to_tensor =
+        |v: &[f64]| Tensor::<1>::from_data(TensorData::new(v.iter().map(|&x| x as f32).collect::<Vec<_>>(), [v.len()]), &device);
+    for (m, record) in records() {
+        let table = Tabulated::with_step(m.as_ref(), (READOUT.0 - 0.005, READOUT.1 + 0.005), step);
+        let params = m.parameters_of(&record).unwrap();
+        let (direct, tabulated) =
+            (m.poses(to_tensor(&params), to_tensor(&TABLE_TIMES)), table.poses(to_tensor(&params), to_tensor(&TABLE_TIMES)));
+        // A change of rate inside an interval of the table is blended over it: off by at most
+        // the jump (here up to 6.4 rad/s, 3.6 m/s) times a quarter step, 6e-5.
+        for (a, b, what) in [
+            (direct.rotation.reshape([-1]), tabulated.rotation.reshape([-1]), "R"),
+            (direct.translation.reshape([-1]), tabulated.translation.reshape([-1]), "T"),
+        ] {
+            let (a, b) = (host(a), host(b));
+            for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+                assert!(
+                    (x - y).abs() < 1e-4,
+                    "{} {what}[{i}] at t = {}: model {x}, table {y}",
+                    m.name(),
+                    TABLE_TIMES[i / if what == "R" { 9 } else { 3 }]
+                );
+            }
+        }
+        // Gradients with respect to the parameters and to the times (the rows' read-out
+        // times carry the per-Gaussian timing's fixed point).
+        let grads = |model: &dyn MotionModel| {
+            let (p, t) = (to_tensor(&params).require_grad(), to_tensor(&TABLE_TIMES).require_grad());
+            let g = pose_sum(model, p.clone(), t.clone()).backward();
+            (host(p.grad(&g).unwrap()), host(t.grad(&g).unwrap()))
+        };
+        let ((dp, dt), (tp, tt)) = (grads(m.as_ref()), grads(&table));
+        let scale = dp.iter().fold(0f32, |a, x| a.max(x.abs()));
+        for (i, (x, y)) in dp.iter().zip(&tp).enumerate() {
+            assert!((x - y).abs() < 1e-3 * scale, "{} d/dparam {i}: model {x}, table {y}", m.name());
+        }
+        // With respect to time the table's slope is its interval's: off by the rate's change
+        // over one step, except next to a change of rate, where it is the blend of both sides.
+        for (i, (x, y)) in dt.iter().zip(&tt).enumerate() {
+            let near_boundary = BOUNDARIES.iter().any(|b| (TABLE_TIMES[i] - b).abs() < step) && m.name() == "piecewise_constant";
+            if !near_boundary {
+                assert!((x - y).abs() < 1e-2 * x.abs().max(1.0), "{} d/dt at t = {}: model {x}, table {y}", m.name(), TABLE_TIMES[i]);
             }
         }
     }

@@ -115,6 +115,11 @@ fn the_readme_main_command_runs_on_its_built_in_scene() {
         assert!(out.join(file).exists(), "{file} missing; stdout: {stdout}");
     }
     assert!(models.join("result/model.json").exists());
+    // The motion prior is in the config's list; stage 1 fits no motion and does not list it.
+    let line = |prefix: &str| stdout.lines().find(|l| l.starts_with(prefix)).unwrap_or_else(|| panic!("no `{prefix}` line: {stdout}"));
+    let (stage1, stage2) = (line("stage 1 fit:"), line("stage 2 fit:"));
+    assert!(stage1.contains("l1×1 + smoothness×0.05") && !stage1.contains("motion_prior"), "{stage1}");
+    assert!(stage2.contains("motion_prior×"), "{stage2}");
     let saved = rslf::model::SavedModel::load(&models.join("result")).unwrap();
     assert_eq!(saved.gaussians.len(), 20_000);
     let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();

@@ -1,4 +1,4 @@
-//! `rslf bench`: the renderer's and stage 1's speed and memory, printed.
+//! `rslf bench`: the renderer's, stage 1's and the cue placement's speed and memory, printed.
 
 use crate::config::{Config, DeviceChoice};
 use crate::io::Scene;
@@ -6,6 +6,7 @@ use crate::model::GaussianSet;
 use crate::random::Rng;
 use crate::render::{RenderSettings, bins_for_view, render};
 use crate::synth::{GenerateOptions, base_scene, generate};
+use burn::module::Module;
 use std::time::Instant;
 
 /// Arguments of `rslf bench`.
@@ -26,6 +27,10 @@ pub struct BenchArgs {
     /// Skip the whole-stage-1 timing.
     #[arg(long)]
     pub render_only: bool,
+    /// Points placed as the measured-cue term places its cues, under each motion model, with its
+    /// poses computed per point and read from a table (0 = skip).
+    #[arg(long, default_value_t = 100_000)]
+    pub cues: usize,
 }
 
 /// Peak resident memory of this process so far, MiB (Linux), if known.
@@ -109,8 +114,95 @@ pub fn run(args: BenchArgs) -> crate::Result<()> {
         }
         println!("  whole stage 1: {:.1} s", start.elapsed().as_secs_f64());
     }
+    if args.cues > 0 {
+        bench_cue_placement(args.cues, args.repeat.max(1))?;
+    }
     if let Some(mib) = peak_rss_mib() {
         println!("peak memory of this process: {mib:.0} MiB");
+    }
+    Ok(())
+}
+
+/// Times one forward+backward placement of `n` points as the measured-cue term places its cues
+/// (lifted, moved back to t = 0 from their rows' times, re-imaged into a corner each with three
+/// fixed-point iterations of their own read-out time; the gradient with respect to the motion),
+/// under each built-in model, its poses computed per point and read from the fit's table
+/// ([`crate::pipeline::pose_table`]); with the largest difference the table makes, pixels.
+fn bench_cue_placement(n: usize, repeat: usize) -> crate::Result<()> {
+    use crate::geometry::{Camera, TensorCamera, ViewGrid, ViewOffset, readout_interval};
+    use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
+    use crate::render::StaticShape;
+    use burn::tensor::{Tensor, TensorData};
+
+    let camera = Camera {
+        grid: ViewGrid { rows: 9, cols: 9 },
+        width: 256,
+        height: 256,
+        f_px: 366.0,
+        baseline_m: 0.02,
+        focus_m: 4.0,
+        line_time_s: 1.5e-4,
+    };
+    let device = crate::device::device(DeviceChoice::Flex)?.autodiff();
+    let mut rng = Rng::new(3);
+    let mut set = GaussianSet { u: vec![], v: vec![], disparity: vec![], size: vec![1.0; n], colour: vec![0.0; n], channels: 1 };
+    let (mut du, mut dv) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for _ in 0..n {
+        set.u.push(rng.range(0.0, 256.0) as f32);
+        set.v.push(rng.range(0.0, 256.0) as f32);
+        set.disparity.push(rng.range(-2.0, 2.0) as f32);
+        du.push(if rng.unit() < 0.5 { -4.0f32 } else { 4.0 });
+        dv.push(if rng.unit() < 0.5 { -4.0f32 } else { 4.0 });
+    }
+    let points = set.to_module(&device).no_grad();
+    let views =
+        ViewOffset::PerPoint(Tensor::from_data(TensorData::new(du, [n]), &device), Tensor::from_data(TensorData::new(dv, [n]), &device));
+    let tc = TensorCamera::new(&camera);
+    let setup = MotionSetup { readout: readout_interval(camera.height, camera.line_time_s) };
+    let registry = MotionRegistry::default();
+    println!("cue placement: {n} points, 256 x 256 px, each into a corner, forward+backward, flex:");
+    for (name, segments, rates) in [
+        ("constant_velocity", 1, vec![0.3, -0.5, 1.2, 0.8, -0.4, 2.0]),
+        ("constant_acceleration", 1, vec![0.3, -0.5, 1.2, 0.8, -0.4, 2.0, 20.0, 5.0, -30.0, -40.0, 10.0, 25.0]),
+        (
+            "piecewise_constant",
+            4,
+            [0.3, -0.5, 1.2, 0.8, -0.4, 2.0].iter().cycle().take(24).enumerate().map(|(i, x)| x * (1.0 + 0.2 * (i / 6) as f64)).collect(),
+        ),
+    ] {
+        let config = crate::config::MotionConfig { model: name.into(), segments };
+        let model = registry.build(&config, &setup).map_err(|e| crate::Error::Usage(e.to_string()))?;
+        let table = crate::pipeline::pose_table(model.as_ref(), &camera);
+        let place = |m: &dyn MotionModel| -> crate::Result<(f64, Vec<f32>)> {
+            let mut times = Vec::new();
+            let mut placed = Vec::new();
+            for _ in 0..repeat + 1 {
+                let start = Instant::now();
+                let params =
+                    Tensor::<1>::from_data(TensorData::new(rates.iter().map(|&x| x as f32).collect::<Vec<_>>(), [rates.len()]), &device)
+                        .require_grad();
+                let shape = StaticShape::new(&points, tc, m, params.clone());
+                let splats = shape.splats_rolling(m, params.clone(), views.clone(), 3);
+                let grads = (splats.u.clone().sum() + splats.v.clone().sum()).backward();
+                let grad = params.grad(&grads).map(|g| g.sum().into_scalar::<f32>());
+                times.push(start.elapsed().as_secs_f64());
+                if grad.is_none_or(|v| !v.is_finite()) {
+                    return Err(crate::Error::Usage(format!("{name}: the gradient did not come back finite")));
+                }
+                placed = [crate::device::host_values(splats.u), crate::device::host_values(splats.v)].concat();
+            }
+            times.remove(0);
+            Ok((times.iter().sum::<f64>() / times.len() as f64, placed))
+        };
+        let ((direct, a), (tabulated, b)) = (place(model.as_ref())?, place(&table)?);
+        let off = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
+        println!(
+            "  {name:22} per point {:6.0} ms, tabulated ({} poses) {:6.0} ms: {:.1}x, placements within {off:.1e} px",
+            direct * 1e3,
+            table.samples,
+            tabulated * 1e3,
+            direct / tabulated
+        );
     }
     Ok(())
 }

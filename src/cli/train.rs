@@ -58,10 +58,8 @@ pub fn run(args: TrainArgs, registries: &pipeline::Registries) -> crate::Result<
             (Some(_), false) => "global shutter".to_string(),
         }
     );
-    let (result, log) = pipeline::run_with(&config, &scene, &device, registries)?;
-    for line in &log.lines {
-        println!("{line}");
-    }
+    // Each stage's line is printed as the stage ends.
+    let (result, _) = pipeline::run_logged(&config, &scene, &device, registries, pipeline::RunLog::printing())?;
     let written = result.write(&out, scene.camera().as_ref())?;
     for path in &written {
         println!("wrote {}", path.display());

@@ -68,6 +68,12 @@ pub trait LossTerm: Send + Sync {
     /// The term's value for one band (a one-element tensor), or `None` when it does not apply
     /// (e.g. a motion prior in a stage without motion).
     fn evaluate(&self, input: &LossInput) -> Option<Tensor<1>>;
+
+    /// Whether the term scores the motion alone (a prior on it), so that it has nothing to score
+    /// in stage 1, which fits no motion: such a term is left out of stage 1's objective and log.
+    fn scores_motion_only(&self) -> bool {
+        false
+    }
 }
 
 /// `[P, C]` band pixels as `[1, C, rows, width]` images, for window operations.

@@ -15,6 +15,10 @@ impl LossTerm for MotionPrior {
         "motion_prior"
     }
 
+    fn scores_motion_only(&self) -> bool {
+        true
+    }
+
     fn evaluate(&self, input: &LossInput) -> Option<Tensor<1>> {
         input.motion.map(|m| (m.scaled.clone() * m.scaled.clone()).mean())
     }

@@ -18,6 +18,10 @@ impl LossTerm for MotionSmoothness {
         "motion_smoothness"
     }
 
+    fn scores_motion_only(&self) -> bool {
+        true
+    }
+
     fn evaluate(&self, input: &LossInput) -> Option<Tensor<1>> {
         let motion = input.motion?;
         let r = motion.model.roughness(motion.scaled.clone())?;

@@ -84,6 +84,13 @@ impl WeightedLosses {
         self.terms.iter().filter(|t| t.weight != 0.0).filter_map(|t| t.term.evaluate(input).map(|v| v * t.weight)).reduce(|a, b| a + b)
     }
 
+    /// These terms less those that score the motion alone ([`LossTerm::scores_motion_only`]):
+    /// the objective of a stage that fits no motion.
+    pub fn without_motion_terms(mut self) -> Self {
+        self.terms.retain(|t| !t.term.scores_motion_only());
+        self
+    }
+
     /// `name×weight` of each term, for logs.
     pub fn names(&self) -> Vec<String> {
         self.terms.iter().map(|t| format!("{}×{}", t.term.name(), t.weight)).collect()

@@ -146,3 +146,19 @@ fn the_registry_builds_what_a_config_lists_and_names_what_it_lacks() {
     let err = registry.build(&[LossConfig::new("perceptual", 1.0)]).err().unwrap().to_string();
     assert!(err.contains("perceptual") && err.contains("smoothness"), "{err}");
 }
+
+#[test]
+fn the_terms_that_score_the_motion_alone_are_those_with_nothing_to_score_without_one() {
+    use crate::config::LossConfig;
+    let registry = LossRegistry::default();
+    let device = Device::flex();
+    let t = band(vec![0.1, 0.4, 0.3, 0.9, 0.2, 0.6, 0.5, 0.8, 0.7], 3, 3, &device);
+    let out = output(band(vec![0.2; 9], 3, 3, &device), vec![0.0, 0.5, 1.0, 0.2, 0.3, 0.9, 1.0, 0.1, 0.4], &device);
+    let all: Vec<LossConfig> = registry.names().into_iter().map(|n| LossConfig::new(n, 1.0)).collect();
+    for term in registry.build(&all).unwrap().terms {
+        let scored = term.term.evaluate(&LossInput { rendered: &out, target: &t, rows: 3, width: 3, motion: None }).is_some();
+        assert_eq!(scored, !term.term.scores_motion_only(), "{}", term.term.name());
+    }
+    let stage1 = registry.build(&all).unwrap().without_motion_terms();
+    assert_eq!(stage1.names(), vec!["dssim×1", "l1×1", "l2×1", "smoothness×1"]);
+}

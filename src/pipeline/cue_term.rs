@@ -5,7 +5,9 @@
 //! read-out time) is moved back to t = 0 under the motion and re-imaged, each at its own row's
 //! time, into its off-row view: the same tensor program that places the Gaussians, so the
 //! gradient with respect to the motion comes from the framework. The term is the mean Huber
-//! penalty of the difference, in pixels.
+//! penalty of the difference, in pixels. The fit hands it the model read from its pose table
+//! ([`super::stage2_fit::pose_table`]), so the model's pose program runs on the table's times, not
+//! on every cue at each of its fixed-point iterations.
 
 use super::measured_cues::Cue;
 use super::params_tensor;

@@ -27,7 +27,7 @@ pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
 pub use spline_image::SplineImage;
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
-pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales};
+pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales, pose_table};
 pub use view_tracking::{Track, TrackSettings, textured_points, track};
 pub use visibility::explained_mask;
 
@@ -65,6 +65,25 @@ const TRUSTED_ALPHA: f32 = 0.5;
 pub struct RunLog {
     /// One line per stage: what ran, with its figures, or why it did not.
     pub lines: Vec<String>,
+    /// Whether each line is also printed to standard output as it is added.
+    echo: bool,
+}
+
+impl RunLog {
+    /// A log that prints each line as it comes, so that a long run shows where it is even with
+    /// its output going to a file (the progress bars draw only on a terminal).
+    pub fn printing() -> Self {
+        Self { lines: Vec::new(), echo: true }
+    }
+
+    /// Adds a line (and prints it, for a [`RunLog::printing`] log).
+    pub fn push(&mut self, line: impl Into<String>) {
+        let line = line.into();
+        if self.echo {
+            println!("{line}");
+        }
+        self.lines.push(line);
+    }
 }
 
 /// The plane-sweep settings a config gives for a scene: the config's range, else the scene's
@@ -225,9 +244,21 @@ pub fn run(config: &Config, scene: &Scene, device: &Device) -> crate::Result<(Ru
 
 /// Runs the pipeline with loss terms and motion models drawn from `registries`.
 pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Registries) -> crate::Result<(RunResult, RunLog)> {
+    run_logged(config, scene, device, registries, RunLog::default())
+}
+
+/// [`run_with`], its lines added to `log` as the stages end ([`RunLog::printing`] shows them as
+/// they come).
+pub fn run_logged(
+    config: &Config,
+    scene: &Scene,
+    device: &Device,
+    registries: &Registries,
+    mut log: RunLog,
+) -> crate::Result<(RunResult, RunLog)> {
     let usage = |e: &dyn std::fmt::Display| crate::Error::Usage(format!("config: {e}"));
     let losses = |stage| registries.losses.build(&config.losses_in(stage)).map_err(|e| usage(&e));
-    let (stage1_losses, stage2_losses) = (losses(1)?, losses(2)?);
+    let (stage1_losses, stage2_losses) = (losses(1)?.without_motion_terms(), losses(2)?);
     let camera = scene.camera();
     let motion_model = match &camera {
         Some(cam) => {
@@ -236,7 +267,6 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
         }
         None => None,
     };
-    let mut log = RunLog::default();
     let (gaussians, initial, mut curves) = stage1(config, scene, &stage1_losses, device, &mut log)?;
     let render = render_settings(config);
 
@@ -268,7 +298,7 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
                 None => vec![0.0; model.parameters().len()],
             };
             if !observable {
-                log.lines.push("stage 2 (motion): the scene has no view off the central row to fit a motion to; stage2.initial_motion is used as given".into());
+                log.push("stage 2 (motion): the scene has no view off the central row to fit a motion to; stage2.initial_motion is used as given");
             }
             // The stage-1 geometry the disocclusion masks come from, rendered only when they are asked for.
             let stage1_disparity = config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
@@ -293,16 +323,15 @@ pub fn run_with(config: &Config, scene: &Scene, device: &Device, registries: &Re
         }
         _ => {
             if scene.is_rolling_shutter() && !observable {
-                log.lines.push(
-                    "stage 2 (motion): skipped, the scene has no view off the central row, whose views are read in step and so show no motion; the result is not compensated"
-                        .into(),
+                log.push(
+                    "stage 2 (motion): skipped, the scene has no view off the central row, whose views are read in step and so show no motion; the result is not compensated",
                 );
             } else if scene.is_rolling_shutter() {
-                log.lines.push("stage 2 (motion): skipped, stage2.iterations = 0; the result is not compensated".into());
+                log.push("stage 2 (motion): skipped, stage2.iterations = 0; the result is not compensated");
             } else if camera.is_none() {
-                log.lines.push("stage 2 (motion): skipped, no parameters.cfg (no camera, so no motion or depth)".into());
+                log.push("stage 2 (motion): skipped, no parameters.cfg (no camera, so no motion or depth)");
             } else {
-                log.lines.push("stage 2 (motion): skipped, global-shutter scene (no [rolling_shutter] in parameters.cfg)".into());
+                log.push("stage 2 (motion): skipped, global-shutter scene (no [rolling_shutter] in parameters.cfg)");
             }
             let (central, disparity) = render_central(&gaussians, scene, &render, &initial, device);
             // With no motion the Gaussians are already the scene at t = 0.
@@ -343,7 +372,7 @@ fn stage1(
                     scene.height()
                 )));
             }
-            log.lines.push(format!("stage 1 initialisation: disparity from {}", path.display()));
+            log.push(format!("stage 1 initialisation: disparity from {}", path.display()));
             map
         }
         None => sweep(config, scene, log),
@@ -351,7 +380,7 @@ fn stage1(
     let start = Instant::now();
     let set = sample_gaussians(scene.central(), &initial, config.stage1.gaussians, config.seed);
     let mut gaussians = set.to_module(device);
-    log.lines.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
+    log.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
 
     let views = stage1_views(scene, config.stage1.views, column_views(config, scene));
     let mut curves = Vec::new();
@@ -372,7 +401,7 @@ fn stage1(
         });
         bar.finish_and_clear();
         gaussians = fitted;
-        log.lines.push(format!(
+        log.push(format!(
             "stage 1 fit: {} Adam steps over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4}, {:.1} s",
             s.iterations,
             s.band_height,
@@ -417,7 +446,7 @@ fn stage2(
         let cue_views = stage2_views(scene, s.cue_views);
         let cues = measure_cues(scene, initial_disparity, &cue_views, s.cue_edges);
         let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
-        log.lines.push(format!(
+        log.push(format!(
             "stage 2 cues: {} measured in {} views off the central row and column ({:?}), {} of them across an edge or a stripe only, textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
             cues.len(),
             measured_in.len(),
@@ -436,7 +465,7 @@ fn stage2(
     let mut views = stage2_views(scene, s.views);
     if s.views == ViewSelection::Corners && views != scene.grid.corners() {
         let names: Vec<String> = views.iter().map(|&v| scene.grid.index(v).to_string()).collect();
-        log.lines.push(format!(
+        log.push(format!(
             "stage 2 views: the grid's four corners are not all present; views {} stand in for them (each quadrant's outermost)",
             names.join(", ")
         ));
@@ -497,7 +526,7 @@ fn stage2(
             },
         );
         bar.finish_and_clear();
-        log.lines.push(format!(
+        log.push(format!(
             "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4}{}, {:.1} s",
             model.name(),
             s.iterations,
@@ -564,7 +593,7 @@ fn check_motion(
     log: &mut RunLog,
 ) -> bool {
     let Some(support) = cue_support(camera, &model.record(&fitted.parameters), cues) else {
-        log.lines.push(format!("stage 2 check: not made ({} measured cues; at least 100 imaged and a motion are needed)", cues.len()));
+        log.push(format!("stage 2 check: not made ({} measured cues; at least 100 imaged and a motion are needed)", cues.len()));
         return false;
     };
     let shown = format!(
@@ -572,12 +601,12 @@ fn check_motion(
         support.cues, support.share, support.standard_error
     );
     if support.confirms(min_support) {
-        log.lines.push(format!("stage 2 check: {shown}, clearly over {min_support}: kept"));
+        log.push(format!("stage 2 check: {shown}, clearly over {min_support}: kept"));
         return true;
     }
     fitted.parameters.iter_mut().for_each(|p| *p = 0.0);
     let verdict = if support.refutes(min_support) { "clearly under" } else { "not clearly over" };
-    log.lines.push(format!("stage 2 check: {shown}, {verdict} {min_support}: taken for a drift of the fit, no motion kept"));
+    log.push(format!("stage 2 check: {shown}, {verdict} {min_support}: taken for a drift of the fit, no motion kept"));
     false
 }
 
@@ -593,7 +622,7 @@ fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
     let start = Instant::now();
     let estimate = plane_sweep(scene, &views, &settings, |done, _| bar.set_position(done as u64));
     bar.finish_and_clear();
-    log.lines.push(format!(
+    log.push(format!(
         "stage 1 initialisation: plane sweep over {} central-row and {} central-column views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
         row_views.len(),
         column.len(),

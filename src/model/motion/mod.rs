@@ -7,11 +7,13 @@ mod constant_acceleration;
 mod constant_velocity;
 mod piecewise_constant;
 mod registry;
+mod tabulated;
 
 pub use constant_acceleration::ConstantAcceleration;
 pub use constant_velocity::ConstantVelocity;
 pub use piecewise_constant::PiecewiseConstant;
 pub use registry::{MotionConstructor, MotionRegistry, MotionSetup, UnknownMotion};
+pub use tabulated::Tabulated;
 
 use crate::geometry::PoseBatch;
 use crate::io::MotionRecord;
