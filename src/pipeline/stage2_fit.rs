@@ -137,9 +137,9 @@ const TABLE_MARGIN_ROWS: f64 = 32.0;
 const TABLE_SAMPLES_PER_ROW: f64 = 4.0;
 
 /// `model` read from a table of its poses over `camera`'s read-out, as the fit places the
-/// Gaussians and the cues: at 100,000 points, 9.4 times as fast as per point for
-/// `piecewise_constant` and 1.7 times for `constant_velocity`, placements within 1e-4 px
-/// (`rslf bench`).
+/// Gaussians and the cues: at 100,000 points, 8.3 times as fast as per point for
+/// `piecewise_constant` and 1.9 times for `constant_velocity`, placements within 1e-4 px
+/// (`rslf bench --cues`; docs/results.md).
 pub fn pose_table<'a>(model: &'a dyn MotionModel, camera: &Camera) -> Tabulated<'a> {
     let span = (camera.row_time(-TABLE_MARGIN_ROWS), camera.row_time(camera.height as f64 - 1.0 + TABLE_MARGIN_ROWS));
     Tabulated::with_step(model, span, camera.line_time_s / TABLE_SAMPLES_PER_ROW)
