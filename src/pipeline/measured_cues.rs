@@ -104,8 +104,12 @@ pub enum CueAxis {
 pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
     let grid = scene.grid;
     let (Some(centre), w, h) = (grid.central(), scene.width(), scene.height()) else { return Vec::new() };
-    let settings = TrackSettings::default();
     let stride = ((w * h) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
+    // Patches grow with the grid, so that they cover the same share of the scene at any size:
+    // 9 x 9 px up to 256 x 256 (stride 2), 17 x 17 at 512. At 512 px 9 x 9 patches gave
+    // 4,714 cues on the README's scene and shared errors of up to 0.03 px a corner; 17 x 17
+    // ones 12,495 and 0.004 px (docs/results.md).
+    let settings = TrackSettings { radius: 2 * stride, ..TrackSettings::default() };
     let mut cues = Vec::new();
     // The views column by column: those of a column are tracked from the same row view.
     let views: Vec<ViewId> = views.iter().copied().filter(|v| v.row != centre.row && v.col != centre.col).collect();
@@ -156,8 +160,8 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
             .collect();
         let points: Vec<(usize, usize)> = patches.iter().map(|p| p.0).collect();
         let first = PatchDisparities::new(&points, first, stride);
-        // The neighbours a gradient is fitted to: those within a patch, or two grid steps.
-        let reach = settings.radius.max(2 * stride);
+        // The neighbours a gradient is fitted to: those within a patch (two grid steps).
+        let reach = settings.radius;
         let found: Vec<Vec<Cue>> = patches
             .par_iter()
             .zip(&first.values)
