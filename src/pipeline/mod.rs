@@ -401,15 +401,17 @@ fn stage1(
         });
         bar.finish_and_clear();
         gaussians = fitted;
+        // Bands are taken in turn, one a step: a round of them is one pass over the views.
+        let ends = curve_ends(&curve, band_count(scene.height(), s.band_height));
         log.push(format!(
-            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4}, {:.1} s",
+            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4} over the first and the last round of bands, {:.1} s",
             s.iterations,
             s.band_height,
             views.iter().filter(|v| v.row == scene.central_id().row).count(),
             views.iter().filter(|v| v.row != scene.central_id().row).count(),
             losses.names().join(" + "),
-            curve.first().copied().unwrap_or(f32::NAN),
-            curve.last().copied().unwrap_or(f32::NAN),
+            ends.0,
+            ends.1,
             start.elapsed().as_secs_f64()
         ));
         curves.push(("stage1".to_string(), curve));
@@ -526,8 +528,11 @@ fn stage2(
             },
         );
         bar.finish_and_clear();
+        // Each step scores `bands_per_step` bands drawn across the image.
+        let bands = band_count(scene.height(), s.band_height);
+        let stage2_ends = curve_ends(&fitted.curve, bands.div_ceil(s.bands_per_step.clamp(1, bands.max(1))));
         log.push(format!(
-            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4}{}, {:.1} s",
+            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}, {:.1} s",
             model.name(),
             s.iterations,
             s.bands_per_step,
@@ -542,8 +547,8 @@ fn stage2(
             if fit.aperture_weighting { ", off-row pixels weighted by their horizontal gradient share" } else { "" },
             cue_term.map_or(String::new(), |c| format!(", measured-cue term ×{} over {} cues", c.weight, c.len)),
             losses.names().join(" + "),
-            fitted.curve.first().copied().unwrap_or(f32::NAN),
-            fitted.curve.last().copied().unwrap_or(f32::NAN),
+            stage2_ends.0,
+            stage2_ends.1,
             fitted.newton.map_or(String::new(), |r| format!(
                 ", then {} of {} Newton steps taken over every band{}, {:.5} -> {:.5} ({} evaluations)",
                 r.taken,
@@ -610,6 +615,22 @@ fn check_motion(
     false
 }
 
+/// The mean loss of a fit's first and last `round` steps (NaN for an empty curve). Each step
+/// scores some bands of rows only, so one step's loss against another's compares different
+/// rows: a stage-1 fit at 512 px read 0.044 -> 0.050 (its top band against its fourth) while
+/// every band's loss fell 2-3x, the round's mean 0.093 -> 0.040. A round of steps covers the
+/// image.
+fn curve_ends(curve: &[f32], round: usize) -> (f32, f32) {
+    let n = round.max(1).min(curve.len());
+    let mean = |steps: &[f32]| if steps.is_empty() { f32::NAN } else { steps.iter().sum::<f32>() / steps.len() as f32 };
+    (mean(&curve[..n]), mean(&curve[curve.len() - n..]))
+}
+
+/// How many bands of `band_height` rows (at least one) cover `height` rows.
+fn band_count(height: usize, band_height: usize) -> usize {
+    height.div_ceil(band_height.clamp(1, height.max(1)))
+}
+
 /// The plane sweep over the central row (and the stage-1 views of the central column): the
 /// initial disparity map.
 fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
@@ -633,4 +654,26 @@ fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
     ));
 
     estimate.disparity
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{band_count, curve_ends};
+
+    #[test]
+    fn a_round_of_bands_compares_the_whole_image_at_both_ends() {
+        // Four bands taken in turn, each loss falling by half over three rounds, the last band
+        // the hardest: its last step reads higher than the first band's first step.
+        let per_band = [0.1_f32, 0.2, 0.3, 0.8];
+        let curve: Vec<f32> = (0..12).map(|step| per_band[step % 4] * 0.5_f32.powi((step / 4) as i32)).collect();
+        assert!(curve[11] > curve[0]);
+        let (first, last) = curve_ends(&curve, band_count(64, 16));
+        assert!((first - 0.35).abs() < 1e-6 && (last - 0.0875).abs() < 1e-6, "{first} -> {last}");
+        // A curve shorter than a round is compared with itself; an empty one gives NaN.
+        let (a, b) = curve_ends(&curve[..3], 4);
+        assert!(a == b && (a - 0.2).abs() < 1e-6, "{a} -> {b}");
+        assert!(curve_ends(&[], 4).0.is_nan());
+        assert_eq!(band_count(100, 16), 7);
+        assert_eq!(band_count(100, 0), 100);
+    }
 }
