@@ -39,7 +39,7 @@ use crate::loss::{LossRegistry, WeightedLosses};
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
 use crate::optim::NewtonSettings;
-use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, splat};
+use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, row_bands, splat};
 use burn::tensor::{Device, Tensor, TensorData};
 use std::time::Instant;
 
@@ -402,7 +402,7 @@ fn stage1(
         bar.finish_and_clear();
         gaussians = fitted;
         // Bands are taken in turn, one a step: a round of them is one pass over the views.
-        let ends = curve_ends(&curve, band_count(scene.height(), s.band_height));
+        let ends = curve_ends(&curve, row_bands(0..scene.height(), s.band_height).len());
         log.push(format!(
             "stage 1 fit: {} Adam steps over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4} over the first and the last round of bands, {:.1} s",
             s.iterations,
@@ -529,7 +529,7 @@ fn stage2(
         );
         bar.finish_and_clear();
         // Each step scores `bands_per_step` bands drawn across the image.
-        let bands = band_count(scene.height(), s.band_height);
+        let bands = row_bands(0..scene.height(), s.band_height).len();
         let stage2_ends = curve_ends(&fitted.curve, bands.div_ceil(s.bands_per_step.clamp(1, bands.max(1))));
         log.push(format!(
             "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}, {:.1} s",
@@ -626,11 +626,6 @@ fn curve_ends(curve: &[f32], round: usize) -> (f32, f32) {
     (mean(&curve[..n]), mean(&curve[curve.len() - n..]))
 }
 
-/// How many bands of `band_height` rows (at least one) cover `height` rows.
-fn band_count(height: usize, band_height: usize) -> usize {
-    height.div_ceil(band_height.clamp(1, height.max(1)))
-}
-
 /// The plane sweep over the central row (and the stage-1 views of the central column): the
 /// initial disparity map.
 fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
@@ -658,7 +653,7 @@ fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
 
 #[cfg(test)]
 mod tests {
-    use super::{band_count, curve_ends};
+    use super::{curve_ends, row_bands};
 
     #[test]
     fn a_round_of_bands_compares_the_whole_image_at_both_ends() {
@@ -667,13 +662,13 @@ mod tests {
         let per_band = [0.1_f32, 0.2, 0.3, 0.8];
         let curve: Vec<f32> = (0..12).map(|step| per_band[step % 4] * 0.5_f32.powi((step / 4) as i32)).collect();
         assert!(curve[11] > curve[0]);
-        let (first, last) = curve_ends(&curve, band_count(64, 16));
+        let (first, last) = curve_ends(&curve, row_bands(0..64, 16).len());
         assert!((first - 0.35).abs() < 1e-6 && (last - 0.0875).abs() < 1e-6, "{first} -> {last}");
         // A curve shorter than a round is compared with itself; an empty one gives NaN.
         let (a, b) = curve_ends(&curve[..3], 4);
         assert!(a == b && (a - 0.2).abs() < 1e-6, "{a} -> {b}");
         assert!(curve_ends(&[], 4).0.is_nan());
-        assert_eq!(band_count(100, 16), 7);
-        assert_eq!(band_count(100, 0), 100);
+        assert_eq!(row_bands(0..100, 16).len(), 7);
+        assert_eq!(row_bands(0..100, 0).len(), 100);
     }
 }

@@ -7,7 +7,7 @@ use crate::io::{Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
 use crate::model::Gaussians;
 use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
-use crate::render::{RenderSettings, bins_for_view, render};
+use crate::render::{RenderSettings, bins_for_view, render, row_bands};
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// Learning rates of the four parameter groups (units of the parameter per step).
@@ -71,8 +71,7 @@ pub fn fit_stage1(
     let (w, h) = (scene.width(), scene.height());
     assert!(!views.is_empty(), "stage 1 needs at least one view");
     let targets = view_targets(scene, views);
-    let band = fit.band_height.clamp(1, h);
-    let bands: Vec<std::ops::Range<usize>> = (0..h).step_by(band).map(|y| y..(y + band).min(h)).collect();
+    let bands = row_bands(0..h, fit.band_height);
     // Band targets are cut once: `[P, C]` per (band, view).
     let band_targets: Vec<Vec<Tensor<2>>> =
         bands.iter().map(|rows| targets.iter().map(|t| band_tensor(t.image, rows.clone(), device)).collect()).collect();

@@ -82,21 +82,24 @@ impl StaticShape {
     }
 }
 
+/// `rows` cut into consecutive bands of `height` rows (at least one), the last one shorter
+/// where they do not divide.
+pub fn row_bands(rows: Range<usize>, height: usize) -> Vec<Range<usize>> {
+    let height = height.max(1);
+    (rows.start..rows.end).step_by(height).map(|y| y..(y + height).min(rows.end)).collect()
+}
+
 /// The bands of `rows` for `timing`: row ranges, each with the read-out time of its centre row
 /// (`None` for per-Gaussian timing, where one set of splats serves all rows).
 pub fn bands(rows: Range<usize>, timing: RsTiming, camera: &TensorCamera) -> Vec<(Range<usize>, Option<f32>)> {
     match timing {
-        RsTiming::Bands(height) => {
-            let height = height.max(1);
-            (rows.start..rows.end)
-                .step_by(height)
-                .map(|y| {
-                    let r = y..(y + height).min(rows.end);
-                    let centre = (r.start + r.end - 1) as f32 / 2.0;
-                    (r, Some((centre - camera.v0) * camera.line_time_s))
-                })
-                .collect()
-        }
+        RsTiming::Bands(height) => row_bands(rows, height)
+            .into_iter()
+            .map(|r| {
+                let centre = (r.start + r.end - 1) as f32 / 2.0;
+                (r, Some((centre - camera.v0) * camera.line_time_s))
+            })
+            .collect(),
         RsTiming::PerGaussian(_) => vec![(rows, None)],
     }
 }
