@@ -154,7 +154,7 @@ mod tests {
             .flat_map(|view| (0..400).map(move |i| (view, i)))
             .filter_map(|(view, i)| {
                 let at = (20.0 + (i % 20) as f64 * 11.0, 20.0 + (i / 20) as f64 * 11.0);
-                let mut cue = Cue { at, disparity: -1.0 + 0.005 * i as f64, view, offset: (0.0, 0.0), across: None };
+                let mut cue = Cue { at, disparity: -1.0 + 0.005 * i as f64, view, offset: (0.0, 0.0), across: None, residual: 0.0 };
                 let p = predicted_cue(&cam, truth, &cue)?;
                 cue.offset = (p.0 + 0.05 * normal(), p.1 + 0.1 * normal());
                 Some(cue)

@@ -34,6 +34,17 @@ const MIN_ACROSS_X: f64 = 0.5;
 /// has no such test: its row match must come out level instead.
 const MAX_EDGE_RESIDUAL: f64 = 0.2;
 
+/// How many times the scene's median unexplained share of contrast (over its patches textured
+/// both ways) either match of such a patch may leave ([`drop_outlying_matches`]). A cue's
+/// error against the true motion grows with that share: on `vegetation_slow2` (256 px) the
+/// fifth of the cues with the lowest share miss it by 0.012 px on average, the other fifths by
+/// 0.035-0.081 px, with vertical means of up to 0.06 px a corner, and on `checkerboards_slow2`
+/// the top fifth misses by 0.049 px against 0.021-0.025. A fixed bound does not fit every
+/// texture: those medians are 0.31 and 0.11, and a bound of 0.2 or 0.3 left `vegetation_slow2`
+/// too few cues (0.087 -> 0.202 and 0.103 px) while it helped `checkerboards_slow2`
+/// (0.104 -> 0.085 and 0.077 px). Twice the median: 0.074 and 0.081 px (docs/results.md).
+const MAX_RESIDUAL_OVER_MEDIAN: f64 = 2.0;
+
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
 /// it sits in one off-row view against where its disparity alone would put it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,6 +63,9 @@ pub struct Cue {
     /// direction its texture varies along for an edge or a stripe, of whose offset only the
     /// component along it is measured (the aperture problem).
     pub across: Option<(f64, f64)>,
+    /// The larger share of the patch's contrast that its two matches (into the row view and
+    /// into the off-row view) leave unexplained ([`Track::relative_residual`]).
+    pub residual: f64,
 }
 
 impl Cue {
@@ -101,7 +115,20 @@ pub enum CueAxis {
 /// Both matches resample the second view by cubic B-spline ([`SplineImage`]): a cue is a small
 /// fraction of a pixel sideways, where bilinear resampling would carry every match about
 /// 0.01 px too far.
+///
+/// A match that leaves much of its patch unexplained is off more than most, and its error is
+/// shared by its neighbours (a fence's thin bars before a backdrop, a texture finer than the
+/// pixels): the patches textured both ways whose matches leave over twice the scene's median
+/// share of their contrast give no cue ([`drop_outlying_matches`]).
 pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
+    let mut cues = tracked_cues(scene, guess, views, edges);
+    drop_outlying_matches(&mut cues);
+    cues
+}
+
+/// Every cue [`measure_cues`] tracks, before it leaves out the patches textured both ways whose
+/// matches are outliers ([`drop_outlying_matches`]); each with its [`Cue::residual`].
+pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
     let grid = scene.grid;
     let (Some(centre), w, h) = (grid.central(), scene.width(), scene.height()) else { return Vec::new() };
     let stride = ((w * h) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
@@ -148,14 +175,15 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
             let linear = [[baseline * slope.0, baseline * slope.1], [0.0, 0.0]];
             let guess = (baseline * start, 0.0);
             let along = texture.normal().map(|_| (1.0, 0.0));
-            let found = track_warped(&row_img, partner, (x, y), guess, linear, along, &settings).filter(|t| fits(t, texture))?.displacement;
-            (found.1.abs() <= 0.25).then_some(found.0 / baseline)
+            let found = track_warped(&row_img, partner, (x, y), guess, linear, along, &settings).filter(|t| fits(t, texture))?;
+            let (dx, dy) = found.displacement;
+            (dy.abs() <= 0.25).then_some((dx / baseline, found.relative_residual()))
         };
         let first: Vec<Option<f64>> = patches
             .par_iter()
             .map(|&((x, y), texture)| {
                 let gx = ((x as f64 + a * guess_d0(guess, x, y)?).round().max(0.0) as usize).min(w - 1);
-                to_partner((x, y), texture, guess_d0(guess, gx, y)?, (0.0, 0.0))
+                to_partner((x, y), texture, guess_d0(guess, gx, y)?, (0.0, 0.0)).map(|(d, _)| d)
             })
             .collect();
         let points: Vec<(usize, usize)> = patches.iter().map(|p| p.0).collect();
@@ -167,7 +195,7 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
             .zip(&first.values)
             .filter_map(|(&((x, y), texture), &d1)| {
                 let slope = first.slope_at((x, y), reach)?;
-                let d = to_partner((x, y), texture, d1?, slope)?;
+                let (d, row_residual) = to_partner((x, y), texture, d1?, slope)?;
                 // The same patch in each view of its column: `b d` rows up or down, and `μ` (its
                 // component across the edges of an edge or a stripe).
                 let in_views = targets.iter().filter_map(|(view, image)| {
@@ -177,7 +205,8 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
                     let track =
                         track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, across, &settings).filter(|t| fits(t, texture))?;
                     let (dx, dy) = track.displacement;
-                    Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across })
+                    let residual = row_residual.max(track.relative_residual());
+                    Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across, residual })
                 });
                 Some(in_views.collect())
             })
@@ -185,6 +214,16 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
         cues.extend(found.into_iter().flatten());
     }
     cues
+}
+
+/// Leaves out the cues of patches textured both ways whose matches leave more than
+/// [`MAX_RESIDUAL_OVER_MEDIAN`] times the median share of contrast unexplained, the median
+/// taken over those patches' cues in `cues` (edges and stripes pass their own, fixed test).
+pub fn drop_outlying_matches(cues: &mut Vec<Cue>) {
+    let mut residuals: Vec<f64> = cues.iter().filter(|c| c.across.is_none()).map(|c| c.residual).collect();
+    residuals.sort_by(f64::total_cmp);
+    let Some(&median) = residuals.get(residuals.len() / 2) else { return };
+    cues.retain(|c| c.across.is_some() || c.residual <= MAX_RESIDUAL_OVER_MEDIAN * median);
 }
 
 /// The present view of the central row farthest from the one `a` views right of the centre,
@@ -280,6 +319,29 @@ mod tests {
         let points: Vec<(usize, usize)> = (0..20).flat_map(|j| (0..20).map(move |i| (10 + 2 * i, 10 + 2 * j))).collect();
         let values: Vec<Option<f64>> = points.iter().map(|&(x, y)| Some(d(x as f64, y as f64))).collect();
         PatchDisparities::new(&points, values, 2)
+    }
+
+    #[test]
+    fn two_way_matches_over_twice_the_median_residual_are_left_out_and_edges_are_not() {
+        let cue = |residual: f64, across: Option<(f64, f64)>| Cue {
+            at: (10.0, 10.0),
+            disparity: 0.5,
+            view: ViewId { row: 0, col: 0 },
+            offset: (0.0, 0.0),
+            across,
+            residual,
+        };
+        // Seven two-way residuals, median 0.16: 0.32 is twice it, 0.33 is over.
+        let mut cues: Vec<Cue> = [0.33, 0.1, 0.12, 0.32, 0.15, 0.16, 0.2].iter().map(|&r| cue(r, None)).collect();
+        // An edge's residual does not count towards the median and is not judged by it.
+        cues.push(cue(0.19, Some((1.0, 0.0))));
+        drop_outlying_matches(&mut cues);
+        let kept: Vec<(f64, bool)> = cues.iter().map(|c| (c.residual, c.across.is_some())).collect();
+        assert_eq!(kept, vec![(0.1, false), (0.12, false), (0.32, false), (0.15, false), (0.16, false), (0.2, false), (0.19, true)]);
+        // No two-way cue, nothing to judge by.
+        let mut edges = vec![cue(0.5, Some((0.0, 1.0)))];
+        drop_outlying_matches(&mut edges);
+        assert_eq!(edges.len(), 1);
     }
 
     #[test]

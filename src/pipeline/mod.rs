@@ -22,7 +22,7 @@ pub use cue_support::{CueSupport, cue_support};
 pub use cue_term::CueTerm;
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
-pub use measured_cues::{Cue, measure_cues, predicted_cue};
+pub use measured_cues::{Cue, drop_outlying_matches, measure_cues, predicted_cue, tracked_cues};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
 pub use spline_image::SplineImage;
