@@ -13,7 +13,7 @@ use rslf::config::{MotionConfig, ViewSelection};
 use rslf::geometry::{TensorCamera, ViewId, readout_interval};
 use rslf::io::{GroundTruth, MotionRecord, Scene, read_pfm};
 use rslf::model::motion::{MotionRegistry, MotionSetup};
-use rslf::pipeline::{Cue, CueTerm, cue_support, measure_cues, plane_sweep, predicted_cue, stage2_views, sweep_settings, tracked_cues};
+use rslf::pipeline::{Cue, CueTerm, cue_support, drop_outlying_matches, measure_cues, plane_sweep, predicted_cue, stage2_views, sweep_settings, tracked_cues};
 use rslf::synth::{GenerateOptions, base_scene, generate};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -142,7 +142,10 @@ fn the_matches_left_out_for_their_residual_are_those_off_the_truth() {
     let (_dir, scene) = moving_objects(&MotionRecord::zero());
     let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
     let (guess, corners) = (gt.disparity.as_ref().unwrap(), scene.grid.corners());
-    let (tracked, kept) = (tracked_cues(&scene, guess, &corners, false), measure_cues(&scene, guess, &corners, false));
+    // What `measure_cues` returns, without tracking the scene a second time.
+    let tracked = tracked_cues(&scene, guess, &corners, false);
+    let mut kept = tracked.clone();
+    drop_outlying_matches(&mut kept);
     let left_out: Vec<&Cue> = tracked.iter().filter(|c| !kept.contains(c)).collect();
     let miss = |cues: &[&Cue]| median(cues.iter().map(|c| c.offset.0.hypot(c.offset.1)).collect());
     let (kept_miss, left_out_miss) = (miss(&kept.iter().collect::<Vec<_>>()), miss(&left_out));
