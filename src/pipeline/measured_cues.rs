@@ -122,7 +122,7 @@ pub enum CueAxis {
 /// share of their contrast give no cue ([`drop_outlying_matches`]).
 pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
     let mut cues = tracked_cues(scene, guess, views, edges);
-    drop_outlying_matches(&mut cues);
+    let _ = drop_outlying_matches(&mut cues);
     cues
 }
 
@@ -219,11 +219,19 @@ pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
 /// Leaves out the cues of patches textured both ways whose matches leave more than
 /// [`MAX_RESIDUAL_OVER_MEDIAN`] times the median share of contrast unexplained, the median
 /// taken over those patches' cues in `cues` (edges and stripes pass their own, fixed test).
-pub fn drop_outlying_matches(cues: &mut Vec<Cue>) {
+/// Returns the bound applied, `None` where `cues` holds no patch textured both ways.
+pub fn drop_outlying_matches(cues: &mut Vec<Cue>) -> Option<f64> {
+    let bound = MAX_RESIDUAL_OVER_MEDIAN * median_two_way_residual(cues)?;
+    cues.retain(|c| c.across.is_some() || c.residual <= bound);
+    Some(bound)
+}
+
+/// The median [`Cue::residual`] of the cues of patches textured both ways (the upper one of an
+/// even count), `None` where there are none.
+pub fn median_two_way_residual(cues: &[Cue]) -> Option<f64> {
     let mut residuals: Vec<f64> = cues.iter().filter(|c| c.across.is_none()).map(|c| c.residual).collect();
     residuals.sort_by(f64::total_cmp);
-    let Some(&median) = residuals.get(residuals.len() / 2) else { return };
-    cues.retain(|c| c.across.is_some() || c.residual <= MAX_RESIDUAL_OVER_MEDIAN * median);
+    residuals.get(residuals.len() / 2).copied()
 }
 
 /// The present view of the central row farthest from the one `a` views right of the centre,
@@ -335,12 +343,12 @@ mod tests {
         let mut cues: Vec<Cue> = [0.33, 0.1, 0.12, 0.32, 0.15, 0.16, 0.2].iter().map(|&r| cue(r, None)).collect();
         // An edge's residual does not count towards the median and is not judged by it.
         cues.push(cue(0.19, Some((1.0, 0.0))));
-        drop_outlying_matches(&mut cues);
+        assert_eq!(drop_outlying_matches(&mut cues), Some(0.32));
         let kept: Vec<(f64, bool)> = cues.iter().map(|c| (c.residual, c.across.is_some())).collect();
         assert_eq!(kept, vec![(0.1, false), (0.12, false), (0.32, false), (0.15, false), (0.16, false), (0.2, false), (0.19, true)]);
         // No two-way cue, nothing to judge by.
         let mut edges = vec![cue(0.5, Some((0.0, 1.0)))];
-        drop_outlying_matches(&mut edges);
+        assert_eq!(drop_outlying_matches(&mut edges), None);
         assert_eq!(edges.len(), 1);
     }
 

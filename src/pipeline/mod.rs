@@ -19,10 +19,10 @@ mod visibility;
 
 pub use aperture::aperture_weights;
 pub use cue_support::{CueSupport, cue_support};
-pub use cue_term::CueTerm;
+pub use cue_term::{CueTerm, residual_weights};
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
-pub use measured_cues::{Cue, drop_outlying_matches, measure_cues, predicted_cue, tracked_cues};
+pub use measured_cues::{Cue, drop_outlying_matches, measure_cues, median_two_way_residual, predicted_cue, tracked_cues};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
 pub use spline_image::SplineImage;
@@ -446,7 +446,9 @@ fn stage2(
     let cues = (s.cue_weight > 0.0 || check).then(|| {
         let start = Instant::now();
         let cue_views = stage2_views(scene, s.cue_views);
-        let cues = measure_cues(scene, initial_disparity, &cue_views, s.cue_edges);
+        let mut cues = tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges);
+        let tracked = cues.len();
+        let bound = drop_outlying_matches(&mut cues);
         let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
         log.push(format!(
             "stage 2 cues: {} measured in {} views off the central row and column ({:?}), {} of them across an edge or a stripe only, textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
@@ -456,6 +458,12 @@ fn stage2(
             cues.iter().filter(|c| c.across.is_some()).count(),
             start.elapsed().as_secs_f64()
         ));
+        if let Some(bound) = bound {
+            log.push(format!(
+                "stage 2 cues left out: {} of {tracked} tracked, patches textured both ways whose matches leave over {bound:.3} of their contrast unexplained (twice the median)",
+                tracked - cues.len()
+            ));
+        }
         cues
     });
     // The term is built where a fit uses it: a motion the check sets to none needs none.
