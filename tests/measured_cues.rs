@@ -15,8 +15,8 @@ use rslf::geometry::{TensorCamera, ViewId, readout_interval};
 use rslf::io::{GroundTruth, MotionRecord, Scene, read_pfm};
 use rslf::model::motion::{MotionRegistry, MotionSetup};
 use rslf::pipeline::{
-    Cue, CueTerm, cue_support, drop_outlying_matches, measure_cues, plane_sweep, predicted_cue, residual_weights, stage2_views,
-    sweep_settings, tracked_cues,
+    Cue, CueTerm, MAX_RESIDUAL_OVER_MEDIAN, cue_support, drop_outlying_matches, measure_cues, plane_sweep, predicted_cue, residual_weights,
+    stage2_views, sweep_settings, tracked_cues,
 };
 use rslf::synth::{GenerateOptions, base_scene, generate};
 
@@ -149,7 +149,7 @@ fn the_matches_that_leave_more_of_their_patch_unexplained_are_further_off_the_tr
     // What `measure_cues` returns, without tracking the scene a second time.
     let tracked = tracked_cues(&scene, guess, &corners, false);
     let mut kept = tracked.clone();
-    let bound = drop_outlying_matches(&mut kept).expect("the scene has patches textured both ways");
+    let bound = drop_outlying_matches(&mut kept, MAX_RESIDUAL_OVER_MEDIAN).expect("the scene has patches textured both ways");
     let left_out: Vec<&Cue> = tracked.iter().filter(|c| !kept.contains(c)).collect();
     let miss = |cues: &[&Cue]| median(cues.iter().map(|c| c.offset.0.hypot(c.offset.1)).collect());
     let (kept_miss, left_out_miss) = (miss(&kept.iter().collect::<Vec<_>>()), miss(&left_out));
@@ -230,7 +230,7 @@ fn the_cue_term_is_zero_at_the_motion_its_cues_were_predicted_from() {
     let device = Device::flex();
     let setup = MotionSetup { readout: readout_interval(camera.height, camera.line_time_s) };
     let model = MotionRegistry::default().build(&MotionConfig { model: "constant_velocity".into(), segments: 1 }, &setup).unwrap();
-    let term = CueTerm::new(&cues, &camera, 1.0, 0.1, 3, &device);
+    let term = CueTerm::new(&cues, &camera, 1.0, 0.1, 3, true, &device);
     let value = |record: &MotionRecord| {
         let params: Vec<f32> = model.parameters_of(record).unwrap().iter().map(|&x| x as f32).collect();
         let n = params.len();

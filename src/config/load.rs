@@ -126,6 +126,9 @@ impl Config {
         if self.stage1.band_height == 0 {
             return fail("stage1.band_height", "must be at least 1 row");
         }
+        if !(self.stage2.cue_outlier_bound == 0.0 || self.stage2.cue_outlier_bound >= 1.0 && self.stage2.cue_outlier_bound.is_finite()) {
+            return fail("stage2.cue_outlier_bound", "must be 0 (no cue left out) or at least 1 (times the median)");
+        }
         if self.stage2.band_height == 0 {
             return fail("stage2.band_height", "must be at least 1 row");
         }
@@ -222,5 +225,10 @@ mod tests {
         assert_eq!(err.key.as_deref(), Some("stage2.cue_weight"));
         let err = parse("[stage2]\nmin_cue_support = 1.5\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.min_cue_support"));
+        for bad in ["0.5", "-1.0", "inf"] {
+            let err = parse(&format!("[stage2]\ncue_outlier_bound = {bad}\n")).unwrap_err();
+            assert_eq!(err.key.as_deref(), Some("stage2.cue_outlier_bound"), "{bad}");
+        }
+        assert_eq!(parse("[stage2]\ncue_outlier_bound = 0.0\n").unwrap().stage2.cue_outlier_bound, 0.0);
     }
 }

@@ -215,6 +215,13 @@ pub struct Stage2Config {
     /// biases of a few percent of the cue that the two-way patches do not (docs/results.md), so
     /// the check never uses them.
     pub cue_edges: bool,
+    /// Cues of patches textured both ways whose row or corner match leaves more than this many
+    /// times the scene's median share of the patch's contrast unexplained are left out, of the
+    /// check and the fit (0 = none left out). Those matches are the ones off the truth.
+    pub cue_outlier_bound: f64,
+    /// The fit weighs down each cue whose matches leave more of its patch unexplained than the
+    /// scene's median, by the inverse square of that share over the median.
+    pub cue_residual_weights: bool,
     /// A motion file (FORMAT's `motion.toml` schema) to start from, e.g. from an IMU; default:
     /// no motion. With `iterations = 0` the scene is compensated with this motion as it is.
     pub initial_motion: Option<PathBuf>,
@@ -248,6 +255,8 @@ impl Default for Stage2Config {
             min_cue_support: 0.5,
             cue_views: ViewSelection::Corners,
             cue_edges: false,
+            cue_outlier_bound: 2.0,
+            cue_residual_weights: true,
             initial_motion: None,
             newton_iterations: 5,
         }

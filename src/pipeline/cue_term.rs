@@ -81,10 +81,19 @@ pub struct CueTerm {
 }
 
 impl CueTerm {
-    /// The term for `cues` of a scene seen by `camera`, on `device`.
-    pub fn new(cues: &[Cue], camera: &Camera, weight: f32, huber_px: f32, timing_iterations: usize, device: &Device) -> Self {
+    /// The term for `cues` of a scene seen by `camera`, on `device`; with `weighed`, each cue
+    /// weighs its [`residual_weights`], else all alike.
+    pub fn new(
+        cues: &[Cue],
+        camera: &Camera,
+        weight: f32,
+        huber_px: f32,
+        timing_iterations: usize,
+        weighed: bool,
+        device: &Device,
+    ) -> Self {
         let n = cues.len();
-        let weights = residual_weights(cues);
+        let weights = if weighed { residual_weights(cues) } else { vec![1.0; n] };
         // The measured components, with the point each belongs to.
         let components: Vec<Component> = cues
             .iter()

@@ -43,7 +43,7 @@ const MAX_EDGE_RESIDUAL: f64 = 0.2;
 /// texture: those medians are 0.31 and 0.11, and a bound of 0.2 or 0.3 left `vegetation_slow2`
 /// too few cues (0.087 -> 0.202 and 0.103 px) while it helped `checkerboards_slow2`
 /// (0.104 -> 0.085 and 0.077 px). Twice the median: 0.074 and 0.081 px (docs/results.md).
-const MAX_RESIDUAL_OVER_MEDIAN: f64 = 2.0;
+pub const MAX_RESIDUAL_OVER_MEDIAN: f64 = 2.0;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
 /// it sits in one off-row view against where its disparity alone would put it.
@@ -122,7 +122,7 @@ pub enum CueAxis {
 /// share of their contrast give no cue ([`drop_outlying_matches`]).
 pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
     let mut cues = tracked_cues(scene, guess, views, edges);
-    let _ = drop_outlying_matches(&mut cues);
+    let _ = drop_outlying_matches(&mut cues, MAX_RESIDUAL_OVER_MEDIAN);
     cues
 }
 
@@ -217,11 +217,15 @@ pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
 }
 
 /// Leaves out the cues of patches textured both ways whose matches leave more than
-/// [`MAX_RESIDUAL_OVER_MEDIAN`] times the median share of contrast unexplained, the median
-/// taken over those patches' cues in `cues` (edges and stripes pass their own, fixed test).
-/// Returns the bound applied, `None` where `cues` holds no patch textured both ways.
-pub fn drop_outlying_matches(cues: &mut Vec<Cue>) -> Option<f64> {
-    let bound = MAX_RESIDUAL_OVER_MEDIAN * median_two_way_residual(cues)?;
+/// `over_median` times the median share of contrast unexplained ([`MAX_RESIDUAL_OVER_MEDIAN`]
+/// by default), the median taken over those patches' cues in `cues` (edges and stripes pass
+/// their own, fixed test). Returns the bound applied, `None` where `cues` holds no patch
+/// textured both ways or `over_median` is 0 (then none is left out).
+pub fn drop_outlying_matches(cues: &mut Vec<Cue>, over_median: f64) -> Option<f64> {
+    if over_median <= 0.0 {
+        return None;
+    }
+    let bound = over_median * median_two_way_residual(cues)?;
     cues.retain(|c| c.across.is_some() || c.residual <= bound);
     Some(bound)
 }
@@ -343,12 +347,12 @@ mod tests {
         let mut cues: Vec<Cue> = [0.33, 0.1, 0.12, 0.32, 0.15, 0.16, 0.2].iter().map(|&r| cue(r, None)).collect();
         // An edge's residual does not count towards the median and is not judged by it.
         cues.push(cue(0.19, Some((1.0, 0.0))));
-        assert_eq!(drop_outlying_matches(&mut cues), Some(0.32));
+        assert_eq!(drop_outlying_matches(&mut cues, MAX_RESIDUAL_OVER_MEDIAN), Some(0.32));
         let kept: Vec<(f64, bool)> = cues.iter().map(|c| (c.residual, c.across.is_some())).collect();
         assert_eq!(kept, vec![(0.1, false), (0.12, false), (0.32, false), (0.15, false), (0.16, false), (0.2, false), (0.19, true)]);
         // No two-way cue, nothing to judge by.
         let mut edges = vec![cue(0.5, Some((0.0, 1.0)))];
-        assert_eq!(drop_outlying_matches(&mut edges), None);
+        assert_eq!(drop_outlying_matches(&mut edges, MAX_RESIDUAL_OVER_MEDIAN), None);
         assert_eq!(edges.len(), 1);
     }
 

@@ -22,7 +22,9 @@ pub use cue_support::{CueSupport, cue_support};
 pub use cue_term::{CueTerm, residual_weights};
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
-pub use measured_cues::{Cue, drop_outlying_matches, measure_cues, median_two_way_residual, predicted_cue, tracked_cues};
+pub use measured_cues::{
+    Cue, MAX_RESIDUAL_OVER_MEDIAN, drop_outlying_matches, measure_cues, median_two_way_residual, predicted_cue, tracked_cues,
+};
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
 pub use spline_image::SplineImage;
@@ -448,7 +450,7 @@ fn stage2(
         let cue_views = stage2_views(scene, s.cue_views);
         let mut cues = tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges);
         let tracked = cues.len();
-        let bound = drop_outlying_matches(&mut cues);
+        let bound = drop_outlying_matches(&mut cues, s.cue_outlier_bound);
         let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
         log.push(format!(
             "stage 2 cues: {} measured in {} views off the central row and column ({:?}), {} of them across an edge or a stripe only, textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
@@ -460,8 +462,9 @@ fn stage2(
         ));
         if let Some(bound) = bound {
             log.push(format!(
-                "stage 2 cues left out: {} of {tracked} tracked, patches textured both ways whose matches leave over {bound:.3} of their contrast unexplained (twice the median)",
-                tracked - cues.len()
+                "stage 2 cues left out: {} of {tracked} tracked, patches textured both ways whose matches leave over {bound:.3} of their contrast unexplained ({} times the median)",
+                tracked - cues.len(),
+                s.cue_outlier_bound
             ));
         }
         cues
@@ -470,7 +473,7 @@ fn stage2(
     let cue_term = || {
         cues.as_ref()
             .filter(|_| s.cue_weight > 0.0)
-            .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, device))
+            .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, s.cue_residual_weights, device))
     };
     let mut views = stage2_views(scene, s.views);
     if s.views == ViewSelection::Corners && views != scene.grid.corners() {
