@@ -217,7 +217,8 @@ pub struct Stage2Config {
     pub cue_edges: bool,
     /// Cues of patches textured both ways whose row or corner match leaves more than this many
     /// times the scene's median share of the patch's contrast unexplained are left out, of the
-    /// check and the fit (0 = none left out). Those matches are the ones off the truth.
+    /// check and the fit (0 = none left out; by default
+    /// [`crate::pipeline::MAX_RESIDUAL_OVER_MEDIAN`], 2). Those matches are the ones off the truth.
     pub cue_outlier_bound: f64,
     /// The fit weighs down each cue whose matches leave more of its patch unexplained than the
     /// scene's median, by the inverse square of that share over the median.

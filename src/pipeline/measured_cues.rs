@@ -42,7 +42,8 @@ const MAX_EDGE_RESIDUAL: f64 = 0.2;
 /// the top fifth misses by 0.049 px against 0.021-0.025. A fixed bound does not fit every
 /// texture: those medians are 0.31 and 0.11, and a bound of 0.2 or 0.3 left `vegetation_slow2`
 /// too few cues (0.087 -> 0.202 and 0.103 px) while it helped `checkerboards_slow2`
-/// (0.104 -> 0.085 and 0.077 px). Twice the median: 0.074 and 0.081 px (docs/results.md).
+/// (0.104 -> 0.085 and 0.077 px). Twice the median: 0.074 and 0.081 px (docs/results.md). The
+/// default of `[stage2] cue_outlier_bound`; `constant_acceleration`'s config keeps every match.
 pub const MAX_RESIDUAL_OVER_MEDIAN: f64 = 2.0;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
