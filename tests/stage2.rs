@@ -189,6 +189,14 @@ fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
         let second = lines(&stdout, "stage 2 fit with the measured cues: ");
         if kept {
             assert!(second.len() == 1 && second[0].contains("measured-cue term ×1 over"), "{stdout}");
+            // The line ends with the motion the fit kept, as motion.toml names it.
+            let number = |x: f64| if x == 0.0 { "0".to_string() } else { format!("{x:.4e}") };
+            let groups: Vec<String> = motion
+                .groups()
+                .into_iter()
+                .map(|(name, values)| format!("{name} [{}]", values.into_iter().map(number).collect::<Vec<_>>().join(", ")))
+                .collect();
+            assert!(second[0].ends_with(&format!("; estimate {}", groups.join(", "))), "{}", second[0]);
             let curve = std::fs::read_to_string(out.join("loss_stage2_cues.csv")).unwrap();
             assert_eq!(curve.lines().count(), 11, "{curve}");
             assert!(motion != none, "{motion:?}");

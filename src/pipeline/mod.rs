@@ -543,7 +543,7 @@ fn stage2(
         let bands = row_bands(0..scene.height(), s.band_height).len();
         let stage2_ends = curve_ends(&fitted.curve, bands.div_ceil(s.bands_per_step.clamp(1, bands.max(1))));
         log.push(format!(
-            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}, {:.1} s",
+            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}, {:.1} s; estimate {}",
             model.name(),
             s.iterations,
             s.bands_per_step,
@@ -569,7 +569,8 @@ fn stage2(
                 r.end,
                 r.evaluations
             )),
-            start.elapsed().as_secs_f64()
+            start.elapsed().as_secs_f64(),
+            estimate_line(model, &fitted.parameters)
         ));
         fitted
     };
@@ -593,6 +594,19 @@ fn stage2(
         curves.push(("stage2_cues".to_string(), fitted.curve.clone()));
     }
     fitted
+}
+
+/// A motion's parameters as `motion.toml` names them, five significant digits each, for the log:
+/// `omega_rad_s [6.2191e-2, 0, 0], velocity_m_s [0, -2.4877e-1, 0]`.
+fn estimate_line(model: &dyn MotionModel, parameters: &[f64]) -> String {
+    let number = |x: f64| if x == 0.0 { "0".to_string() } else { format!("{x:.4e}") };
+    model
+        .record(parameters)
+        .groups()
+        .into_iter()
+        .map(|(name, values)| format!("{name} [{}]", values.into_iter().map(number).collect::<Vec<_>>().join(", ")))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Keeps the fitted motion only when the cues measured between the views confirm it at
