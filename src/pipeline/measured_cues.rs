@@ -19,7 +19,7 @@ use crate::geometry::{Camera, ViewId, pose_at, readout_interval, rs_project};
 use crate::io::{MotionRecord, Raster, Scene};
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// The least horizontal share of an edge's or a stripe's normal for its patch to give a cue: the
 /// disparity is matched along the row, and a nearly horizontal edge does not pin it.
@@ -45,6 +45,20 @@ const MAX_EDGE_RESIDUAL: f64 = 0.2;
 /// (0.104 -> 0.085 and 0.077 px). Twice the median: 0.074 and 0.081 px (docs/results.md). The
 /// default of `[stage2] cue_outlier_bound`; `constant_acceleration`'s config keeps every match.
 pub const MAX_RESIDUAL_OVER_MEDIAN: f64 = 2.0;
+
+/// Half-size of the larger patch each grid point is also tracked with, in grid steps (13 x 13 px
+/// up to 256 x 256, 25 x 25 at 512; the base patch is two steps: 9 x 9 and 17 x 17). More pixels
+/// average more of the bias a texture that is not band-limited leaves in a match, where one
+/// displacement explains them all; where a patch holds two depths (a fence's thin bars before a
+/// backdrop) it is the larger patch that mixes them (docs/results.md).
+const LARGE_PATCH_STEPS: usize = 3;
+
+/// The largest share of its contrast ([`Track::relative_residual`]) that either match of a
+/// larger patch may leave unexplained for its cue to replace the base patch's. On the 256 px
+/// suite 72 % of `checkerboards_slow2`'s cues pass and 12 % of `vegetation_slow2`'s; with 13 x 13
+/// patches everywhere `checkerboards_slow2` went from 0.068 to 0.028 px and `vegetation_slow2`
+/// from 0.078 to 0.239 px (docs/results.md).
+const MAX_LARGE_PATCH_RESIDUAL: f64 = 0.15;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
 /// it sits in one off-row view against where its disparity alone would put it.
@@ -117,6 +131,12 @@ pub enum CueAxis {
 /// fraction of a pixel sideways, where bilinear resampling would carry every match about
 /// 0.01 px too far.
 ///
+/// Each grid point is tracked with two patches, the base one and a larger one
+/// (`LARGE_PATCH_STEPS`); the larger one's cue is kept where both of its matches leave little
+/// of it unexplained (`MAX_LARGE_PATCH_RESIDUAL`): more pixels average more of the bias of a
+/// texture that is not band-limited (a checker's sharp edges), but where a patch holds two
+/// depths it is the larger one that mixes them, and the base patch's cue stays.
+///
 /// A match that leaves much of its patch unexplained is off more than most, and its error is
 /// shared by its neighbours (a fence's thin bars before a backdrop, a texture finer than the
 /// pixels): the patches textured both ways whose matches leave over twice the scene's median
@@ -130,14 +150,38 @@ pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
 /// Every cue [`measure_cues`] tracks, before it leaves out the patches textured both ways whose
 /// matches are outliers ([`drop_outlying_matches`]); each with its [`Cue::residual`].
 pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
-    let grid = scene.grid;
-    let (Some(centre), w, h) = (grid.central(), scene.width(), scene.height()) else { return Vec::new() };
-    let stride = ((w * h) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
+    let stride = ((scene.width() * scene.height()) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
     // Patches grow with the grid, so that they cover the same share of the scene at any size:
     // 9 x 9 px up to 256 x 256 (stride 2), 17 x 17 at 512. At 512 px 9 x 9 patches gave
     // 4,714 cues on the README's scene and shared errors of up to 0.03 px a corner; 17 x 17
     // ones 12,495 and 0.004 px (docs/results.md).
-    let settings = TrackSettings { radius: 2 * stride, ..TrackSettings::default() };
+    let base = patch_cues(scene, guess, views, edges, 2 * stride, stride);
+    let large = patch_cues(scene, guess, views, edges, LARGE_PATCH_STEPS * stride, stride);
+    prefer_large_patches(base, large)
+}
+
+/// A cue with the grid point of the central-row view whose patch gave it.
+type PatchCue = ((usize, usize), Cue);
+
+/// The cues of `base` patches, each replaced by its `large` patch's where both of that one's
+/// matches leave at most [`MAX_LARGE_PATCH_RESIDUAL`] of its contrast unexplained, and the large
+/// patches' cues that pass that test where the base patch gave none (too little texture, or
+/// lost), after them.
+fn prefer_large_patches(base: Vec<PatchCue>, large: Vec<PatchCue>) -> Vec<Cue> {
+    let key = |(at, cue): &PatchCue| (cue.view, *at);
+    let sure: HashMap<_, Cue> = large.iter().filter(|p| p.1.residual <= MAX_LARGE_PATCH_RESIDUAL).map(|p| (key(p), p.1)).collect();
+    let in_base: HashSet<_> = base.iter().map(key).collect();
+    let mut cues: Vec<Cue> = base.iter().map(|p| sure.get(&key(p)).copied().unwrap_or(p.1)).collect();
+    cues.extend(large.iter().filter(|p| !in_base.contains(&key(p)) && sure.contains_key(&key(p))).map(|p| p.1));
+    cues
+}
+
+/// The cues of the patches of half-size `radius` on the grid of step `stride`, column by column
+/// ([`tracked_cues`]).
+fn patch_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool, radius: usize, stride: usize) -> Vec<PatchCue> {
+    let grid = scene.grid;
+    let (Some(centre), w) = (grid.central(), scene.width()) else { return Vec::new() };
+    let settings = TrackSettings { radius, ..TrackSettings::default() };
     let mut cues = Vec::new();
     // The views column by column: those of a column are tracked from the same row view.
     let views: Vec<ViewId> = views.iter().copied().filter(|v| v.row != centre.row && v.col != centre.col).collect();
@@ -191,7 +235,7 @@ pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
         let first = PatchDisparities::new(&points, first, stride);
         // The neighbours a gradient is fitted to: those within a patch (two grid steps).
         let reach = settings.radius;
-        let found: Vec<Vec<Cue>> = patches
+        let found: Vec<Vec<PatchCue>> = patches
             .par_iter()
             .zip(&first.values)
             .filter_map(|(&((x, y), texture), &d1)| {
@@ -207,7 +251,10 @@ pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool
                         track_warped(&row_img, image, (x, y), (0.0, -b * d), linear, across, &settings).filter(|t| fits(t, texture))?;
                     let (dx, dy) = track.displacement;
                     let residual = row_residual.max(track.relative_residual());
-                    Some(Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across, residual })
+                    Some((
+                        (x, y),
+                        Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across, residual },
+                    ))
                 });
                 Some(in_views.collect())
             })
@@ -355,6 +402,28 @@ mod tests {
         let mut edges = vec![cue(0.5, Some((0.0, 1.0)))];
         assert_eq!(drop_outlying_matches(&mut edges, MAX_RESIDUAL_OVER_MEDIAN), None);
         assert_eq!(edges.len(), 1);
+    }
+
+    #[test]
+    fn a_large_patch_replaces_the_base_one_only_where_one_displacement_explains_it() {
+        // A cue told apart by its offset: 1 for the base patches, 2 for the large ones.
+        let cue = |col: usize, offset: f64, residual: f64| Cue {
+            at: (10.0, 10.0),
+            disparity: 0.5,
+            view: ViewId { row: 0, col },
+            offset: (offset, 0.0),
+            across: None,
+            residual,
+        };
+        let (clean, mixed) = (MAX_LARGE_PATCH_RESIDUAL, MAX_LARGE_PATCH_RESIDUAL + 0.01);
+        let base = vec![((4, 4), cue(0, 1.0, 0.3)), ((4, 4), cue(8, 1.0, 0.05)), ((6, 4), cue(0, 1.0, 0.05))];
+        // The same patch in another view is another cue; (8, 4) has no base cue.
+        let large =
+            vec![((4, 4), cue(8, 2.0, mixed)), ((4, 4), cue(0, 2.0, clean)), ((8, 4), cue(0, 2.0, 0.0)), ((10, 4), cue(0, 2.0, mixed))];
+        let cues = prefer_large_patches(base, large);
+        let got: Vec<(usize, f64)> = cues.iter().map(|c| (c.view.col, c.offset.0)).collect();
+        assert_eq!(got, vec![(0, 2.0), (8, 1.0), (0, 1.0), (0, 2.0)]);
+        assert_eq!(cues[3].residual, 0.0);
     }
 
     #[test]
