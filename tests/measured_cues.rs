@@ -136,8 +136,8 @@ fn a_still_scene_s_edges_and_stripes_sit_on_zero_whichever_way_they_run() {
         eprintln!("normals {:.2}-{:.2} horizontal: {} cues, signed mean {mean:.4} px, RMS {rms:.4} px", g[0], g[1], values.len());
         // Measured: within 0.014 px (the wall's 45° stripes; 0.002-0.008 px elsewhere); -0.13,
         // -0.04, 0.09 and 0.15 px in four of the six groups with the outlines left in. Each
-        // group must hold enough cues for its mean to be known to 0.01 px (the steepest, 0.8-0.9,
-        // has 23 since the larger patches, RMS 0.015 px).
+        // group must hold enough cues for its mean to be known to 0.01 px (that of normals
+        // 0.8-0.9 horizontal has 23 since the larger patches, RMS 0.015 px).
         let standard_error = rms / n.sqrt();
         assert!(n >= 10.0 && standard_error < 0.01 && mean.abs() < 0.03, "normals {g:?}: {n} cues, signed mean {mean}, RMS {rms}");
     }
