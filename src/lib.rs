@@ -17,6 +17,19 @@
 
 #![warn(missing_docs)]
 
+/// `print!` for what rslf says on standard output; a reader that has gone ends the program
+/// quietly where `print!` would panic (`output::write_out`). Defined before the modules so
+/// that every one of them can use it.
+macro_rules! out {
+    ($($arg:tt)*) => { $crate::output::write_out(format_args!($($arg)*)) };
+}
+
+/// `out!` with a newline, as `println!`.
+macro_rules! outln {
+    () => { out!("\n") };
+    ($($arg:tt)*) => { out!("{}\n", format_args!($($arg)*)) };
+}
+
 pub mod cli;
 pub mod config;
 pub mod device;
@@ -27,6 +40,7 @@ pub mod io;
 pub mod loss;
 pub mod model;
 pub mod optim;
+mod output;
 pub mod pipeline;
 pub mod progress;
 pub mod random;

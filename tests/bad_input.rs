@@ -1,5 +1,5 @@
 //! Every kind of bad input ends with a one-line error naming the file, a non-zero exit, no
-//! panic and no partial output.
+//! panic and no partial output; output that nobody reads any more ends the program quietly.
 
 mod common;
 
@@ -173,4 +173,22 @@ fn eval_of_a_scene_without_ground_truth_says_so() {
     let (ok, _, stderr) = rslf(&["eval", "--scene", scene.to_str().unwrap(), "--result", result.to_str().unwrap()]);
     assert!(!ok);
     assert!(stderr.contains("has no ground truth"), "{stderr}");
+}
+
+#[test]
+fn output_whose_reader_has_gone_ends_quietly_with_the_status_of_sigpipe() {
+    // `rslf generate --suite --list | head`, with the reader gone before the first line: the
+    // program ends at once, saying nothing, with the status a shell reports for a tool that
+    // SIGPIPE ended (128 + 13), where `println!` panicked (status 101, a backtrace on stderr).
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_rslf"))
+        .args(["generate", "--suite", "--list"])
+        .current_dir(common::project_dir())
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(141), "{stderr}");
+    assert!(stderr.is_empty(), "{stderr}");
 }

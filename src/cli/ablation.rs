@@ -68,7 +68,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
     if entries.is_empty() {
         return Err(crate::Error::Usage(format!("ablation: no suite scene matches --bases {}", args.bases.join(","))));
     }
-    println!("ablation: {} scenes x {} variants at {s}x{s} px", entries.len(), VARIANTS.len(), s = args.size);
+    outln!("ablation: {} scenes x {} variants at {s}x{s} px", entries.len(), VARIANTS.len(), s = args.size);
     let mut rows = Vec::new();
     for entry in &entries {
         let scene_dir = cached_suite_scene(entry, &options)?;
@@ -96,7 +96,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
                 .unwrap_or(f64::NAN);
             let image = report.motion.as_ref().and_then(|m| m.image.as_ref());
             let (motion_error_px, true_shift_px) = (image.map(|i| i.rms_error_px), image.map(|i| i.rms_true_shift_px));
-            println!(
+            outln!(
                 "  {:24} {:20} rmse {:.4}  abs diff {:.4} m  BadPix(0.07) {:.1}%{}  ({:.0} s)",
                 entry.name,
                 variant,
@@ -109,7 +109,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
             // The cue check's verdict where stage 2 ran: a drift it kept on a still scene shows
             // here by name, not only as a motion error.
             if let Some(check) = log.lines.iter().find_map(|l| l.strip_prefix("stage 2 check: ")) {
-                println!("  {:24} {:20} check: {check}", "", "");
+                outln!("  {:24} {:20} check: {check}", "", "");
             }
             rows.push(Row {
                 scene: entry.name.clone(),
@@ -125,7 +125,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
         }
     }
     let table = table(&rows);
-    println!("\n{table}");
+    outln!("\n{table}");
     let optional = |v: Option<f64>| v.map_or(String::new(), |e| e.to_string());
     let csv: String = std::iter::once(
         "scene,category,variant,rmse_intensity,abs_diff_depth_m,badpix_007_percent,motion_error_px,true_shift_px,seconds\n".to_string(),
@@ -147,7 +147,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
     .collect();
     write_atomic(&args.out.join("ablation.csv"), csv.as_bytes())?;
     write_atomic(&args.out.join("ablation.md"), table.as_bytes())?;
-    println!("wrote {} and ablation.csv", args.out.join("ablation.md").display());
+    outln!("wrote {} and ablation.csv", args.out.join("ablation.md").display());
     Ok(())
 }
 

@@ -61,7 +61,7 @@ pub fn run(args: BenchArgs) -> crate::Result<()> {
     let set = random_set(n, s, 1);
     let settings = RenderSettings::default();
     let offset = (-2.0, 0.0);
-    println!("render: {s}x{s} px, {n} Gaussians, K = {}, view offset {offset:?}", settings.max_per_pixel);
+    outln!("render: {s}x{s} px, {n} Gaussians, K = {}, view offset {offset:?}", settings.max_per_pixel);
     for &choice in &args.devices {
         let device = crate::device::device(choice)?;
         let start = Instant::now();
@@ -83,7 +83,7 @@ pub fn run(args: BenchArgs) -> crate::Result<()> {
         times.remove(0); // the first run warms caches and compiles kernels
         let best = times.iter().copied().fold(f64::INFINITY, f64::min);
         let mean = times.iter().sum::<f64>() / times.len() as f64;
-        println!(
+        outln!(
             "  {choice:?}: forward+backward {:.0} ms (best {:.0} ms of {}), binning {:.0} ms, {:.1}% pixels with K full",
             mean * 1e3,
             best * 1e3,
@@ -108,17 +108,17 @@ pub fn run(args: BenchArgs) -> crate::Result<()> {
         let device = crate::device::device(DeviceChoice::Flex)?;
         let start = Instant::now();
         let (_, log) = crate::pipeline::run(&config, &loaded, &device)?;
-        println!("stage 1 on the generated `objects` scene ({s}x{s}, 81 views generated in {generated:.1} s), flex:");
+        outln!("stage 1 on the generated `objects` scene ({s}x{s}, 81 views generated in {generated:.1} s), flex:");
         for line in log.lines {
-            println!("  {line}");
+            outln!("  {line}");
         }
-        println!("  whole stage 1: {:.1} s", start.elapsed().as_secs_f64());
+        outln!("  whole stage 1: {:.1} s", start.elapsed().as_secs_f64());
     }
     if args.cues > 0 {
         bench_cue_placement(args.cues, args.repeat.max(1))?;
     }
     if let Some(mib) = peak_rss_mib() {
-        println!("peak memory of this process: {mib:.0} MiB");
+        outln!("peak memory of this process: {mib:.0} MiB");
     }
     Ok(())
 }
@@ -160,7 +160,7 @@ fn bench_cue_placement(n: usize, repeat: usize) -> crate::Result<()> {
     let tc = TensorCamera::new(&camera);
     let setup = MotionSetup { readout: readout_interval(camera.height, camera.line_time_s) };
     let registry = MotionRegistry::default();
-    println!("cue placement: {n} points, 256 x 256 px, each into a corner, forward+backward, flex:");
+    outln!("cue placement: {n} points, 256 x 256 px, each into a corner, forward+backward, flex:");
     for (name, segments, rates) in [
         ("constant_velocity", 1, vec![0.3, -0.5, 1.2, 0.8, -0.4, 2.0]),
         ("constant_acceleration", 1, vec![0.3, -0.5, 1.2, 0.8, -0.4, 2.0, 20.0, 5.0, -30.0, -40.0, 10.0, 25.0]),
@@ -196,7 +196,7 @@ fn bench_cue_placement(n: usize, repeat: usize) -> crate::Result<()> {
         };
         let ((direct, a), (tabulated, b)) = (place(model.as_ref())?, place(&table)?);
         let off = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0f32, f32::max);
-        println!(
+        outln!(
             "  {name:22} per point {:6.0} ms, tabulated ({} poses) {:6.0} ms: {:.1}x, placements within {off:.1e} px",
             direct * 1e3,
             table.samples,

@@ -21,11 +21,11 @@ pub struct EvalArgs {
 /// `metrics.json` into the result folder.
 pub fn report(scene: &Path, result: &Path, write: bool) -> crate::Result<()> {
     let report = evaluate(scene, result)?;
-    print!("{report}");
+    out!("{report}");
     if write {
         let path = result.join("metrics.json");
         report.write_json(&path)?;
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     Ok(())
 }

@@ -59,8 +59,8 @@ pub fn run(args: GenerateArgs) -> crate::Result<()> {
     if args.suite {
         let entries = suite(&options)?;
         match &args.out {
-            Some(out) if !args.list => println!("suite: {} scenes into {}", entries.len(), out.display()),
-            _ => println!("suite: {} scenes", entries.len()),
+            Some(out) if !args.list => outln!("suite: {} scenes into {}", entries.len(), out.display()),
+            _ => outln!("suite: {} scenes", entries.len()),
         }
         for entry in &entries {
             let timing = match (&args.out, args.list) {
@@ -70,7 +70,7 @@ pub fn run(args: GenerateArgs) -> crate::Result<()> {
             let motion = entry.description.motion().map_err(crate::Error::Usage)?;
             let groups = motion.groups();
             let round = |v: &[f64]| v.iter().map(|x| (x * 1e4).round() / 1e4).collect::<Vec<_>>();
-            println!(
+            outln!(
                 "{:<22} {:<6} max shift {:>5.2} px  omega {:?} rad/s  v {:?} m/s{timing}",
                 entry.name,
                 entry.category,
@@ -86,6 +86,6 @@ pub fn run(args: GenerateArgs) -> crate::Result<()> {
     };
     let description = SceneDescription::read(&path)?;
     let seconds = one(&description, &options, &out, args.force)?;
-    println!("wrote {} ({} views rendered in {seconds:.1} s)", out.display(), description.camera.num_cams.pow(2));
+    outln!("wrote {} ({} views rendered in {seconds:.1} s)", out.display(), description.camera.num_cams.pow(2));
     Ok(())
 }

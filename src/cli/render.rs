@@ -37,7 +37,7 @@ pub fn run(args: RenderArgs) -> crate::Result<()> {
     let saved = SavedModel::load(&args.model)?;
     let device = crate::device::device(args.device)?;
     let [w, h] = saved.size;
-    println!(
+    outln!(
         "model {}: {} Gaussians, {}x{} px, {}x{} views, {}",
         args.model.display(),
         saved.gaussians.len(),
@@ -74,11 +74,11 @@ pub fn run(args: RenderArgs) -> crate::Result<()> {
             None => Ok(()),
         }
     })?;
-    println!("wrote {} ({} views{})", args.out.display(), views.len(), if parameters.is_some() { ", parameters.cfg" } else { "" });
+    outln!("wrote {} ({} views{})", args.out.display(), views.len(), if parameters.is_some() { ", parameters.cfg" } else { "" });
 
     let reproduces_capture = args.at == Moment::Capture || saved.motion.is_none();
     if !reproduces_capture {
-        println!("PSNR: not computed; the t = 0 light field differs from the captured views by the motion (use --at capture)");
+        outln!("PSNR: not computed; the t = 0 light field differs from the captured views by the motion (use --at capture)");
         return Ok(());
     }
     let scene_dir = args.scene.unwrap_or_else(|| saved.scene.clone());
@@ -86,7 +86,7 @@ pub fn run(args: RenderArgs) -> crate::Result<()> {
         Ok(scene) if scene.width() == w && scene.height() == h && scene.grid.len() == views.len() => scene,
         Ok(_) => return Err(crate::Error::Usage(format!("{}: not the size or grid of the model", scene_dir.display()))),
         Err(e) => {
-            println!("PSNR: not computed, the input scene does not load ({e}); pass --scene DIR");
+            outln!("PSNR: not computed, the input scene does not load ({e}); pass --scene DIR");
             return Ok(());
         }
     };
@@ -99,10 +99,10 @@ pub fn run(args: RenderArgs) -> crate::Result<()> {
             (i, psnr_db(&views[i], scene.view(v).expect("present"), &region))
         })
         .collect();
-    print!("{}", psnr_grid(&scene, &scores));
+    out!("{}", psnr_grid(&scene, &scores));
     let mean = scores.iter().map(|(_, db)| db).sum::<f64>() / scores.len() as f64;
     let (worst_view, worst) = scores.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1)).expect("a scene has its central view");
-    println!(
+    outln!(
         "PSNR against the {} input views of {}: mean {mean:.2} dB, lowest {worst:.2} dB (view {worst_view})",
         scores.len(),
         scene_dir.display()

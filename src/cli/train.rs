@@ -44,7 +44,7 @@ pub fn run(args: TrainArgs, registries: &pipeline::Registries) -> crate::Result<
     let device = crate::device::device(args.device.unwrap_or(config.device))?;
     let scene = Scene::load(&scene_dir)?;
     let gt = GroundTruth::load(&scene_dir, scene.width(), scene.height())?;
-    println!(
+    outln!(
         "scene {}: {} of {} views, {}x{} px, {} channel(s), {}",
         scene_dir.display(),
         scene.present_views().len(),
@@ -62,7 +62,7 @@ pub fn run(args: TrainArgs, registries: &pipeline::Registries) -> crate::Result<
     let (result, _) = pipeline::run_logged(&config, &scene, &device, registries, pipeline::RunLog::printing())?;
     let written = result.write(&out, scene.camera().as_ref())?;
     for path in &written {
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     if let Some(gaussians) = &result.gaussians {
         let name = out.file_name().map_or("run".into(), |n| n.to_string_lossy().into_owned());
@@ -70,7 +70,7 @@ pub fn run(args: TrainArgs, registries: &pipeline::Registries) -> crate::Result<
         let grid = [scene.grid.rows, scene.grid.cols];
         let model = SavedModel::new(&scene_dir, size, grid, gaussians.clone(), result.motion.as_ref(), scene.params.as_ref());
         let path = model.save(&args.models.join(name))?;
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     if !gt.is_empty() {
         super::eval::report(&scene_dir, &out, true)?;

@@ -82,7 +82,7 @@ impl RunLog {
     pub fn push(&mut self, line: impl Into<String>) {
         let line = line.into();
         if self.echo {
-            println!("{line}");
+            outln!("{line}");
         }
         self.lines.push(line);
     }

@@ -62,7 +62,7 @@ fn cached_in(root: &Path, entry: &SuiteEntry, options: &GenerateOptions) -> IoRe
         return Ok(dir);
     }
     let why = if dir.exists() { "again: the folder there was generated from something else, or not completely" } else { "once" };
-    println!("generating built-in scene {} into {} ({why})", entry.name, dir.display());
+    outln!("generating built-in scene {} into {} ({why})", entry.name, dir.display());
     let scene = generate_with_progress(&entry.description, options).map_err(|e| IoError::new(&dir, e))?;
     scene.write(&dir, true)?;
     // Written last: a folder without it (an interrupted run) is generated again.
