@@ -15,8 +15,8 @@ use rslf::geometry::{TensorCamera, ViewId, readout_interval};
 use rslf::io::{GroundTruth, MotionRecord, Scene, read_pfm};
 use rslf::model::motion::{MotionRegistry, MotionSetup};
 use rslf::pipeline::{
-    Cue, CueTerm, MAX_RESIDUAL_OVER_MEDIAN, cue_support, drop_outlying_matches, measure_cues, plane_sweep, predicted_cue, residual_weights,
-    stage2_views, sweep_settings, tracked_cues,
+    Cue, CueTerm, MAX_LEVER_STEPS, MAX_RESIDUAL_OVER_MEDIAN, cue_support, drop_outlying_matches, measure_cues, plane_sweep, predicted_cue,
+    residual_weights, stage2_views, sweep_settings, tracked_cues,
 };
 use rslf::synth::{GenerateOptions, base_scene, generate};
 
@@ -150,7 +150,7 @@ fn the_matches_that_leave_more_of_their_patch_unexplained_are_further_off_the_tr
     let gt = GroundTruth::load(&scene.dir, 256, 256).unwrap();
     let (guess, corners) = (gt.disparity.as_ref().unwrap(), scene.grid.corners());
     // What `measure_cues` returns, without tracking the scene a second time.
-    let tracked = tracked_cues(&scene, guess, &corners, false);
+    let tracked = tracked_cues(&scene, guess, &corners, false, MAX_LEVER_STEPS);
     let mut kept = tracked.clone();
     let bound = drop_outlying_matches(&mut kept, MAX_RESIDUAL_OVER_MEDIAN).expect("the scene has patches textured both ways");
     let left_out: Vec<&Cue> = tracked.iter().filter(|c| !kept.contains(c)).collect();

@@ -129,6 +129,9 @@ impl Config {
         if !(self.stage2.cue_outlier_bound == 0.0 || self.stage2.cue_outlier_bound >= 1.0 && self.stage2.cue_outlier_bound.is_finite()) {
             return fail("stage2.cue_outlier_bound", "must be 0 (no cue left out) or at least 1 (times the median)");
         }
+        if !(self.stage2.cue_lever_bound >= 0.0 && self.stage2.cue_lever_bound.is_finite()) {
+            return fail("stage2.cue_lever_bound", "must be 0 (no cue left out) or a positive number of grid steps");
+        }
         if self.stage2.band_height == 0 {
             return fail("stage2.band_height", "must be at least 1 row");
         }
@@ -230,5 +233,10 @@ mod tests {
             assert_eq!(err.key.as_deref(), Some("stage2.cue_outlier_bound"), "{bad}");
         }
         assert_eq!(parse("[stage2]\ncue_outlier_bound = 0.0\n").unwrap().stage2.cue_outlier_bound, 0.0);
+        for bad in ["-1.0", "nan", "inf"] {
+            let err = parse(&format!("[stage2]\ncue_lever_bound = {bad}\n")).unwrap_err();
+            assert_eq!(err.key.as_deref(), Some("stage2.cue_lever_bound"), "{bad}");
+        }
+        assert_eq!(parse("[stage2]\ncue_lever_bound = 0.0\n").unwrap().stage2.cue_lever_bound, 0.0);
     }
 }

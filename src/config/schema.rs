@@ -220,6 +220,12 @@ pub struct Stage2Config {
     /// check and the fit (0 = none left out; by default
     /// [`crate::pipeline::MAX_RESIDUAL_OVER_MEDIAN`], 2). Those matches are the ones off the truth.
     pub cue_outlier_bound: f64,
+    /// Cues of patches textured both ways whose two matches pin their displacements more than
+    /// this many grid steps apart along x are left out, of the check and the fit (0 = none left
+    /// out; by default [`crate::pipeline::MAX_LEVER_STEPS`], 1). The disparity gradient that
+    /// carries both to the patch centre is off where the patch does not pin it, and such a cue
+    /// by `b` times that error times the distance.
+    pub cue_lever_bound: f64,
     /// The fit weighs down each cue whose matches leave more of its patch unexplained than the
     /// scene's median, by the inverse square of that share over the median.
     pub cue_residual_weights: bool,
@@ -257,6 +263,7 @@ impl Default for Stage2Config {
             cue_views: ViewSelection::Corners,
             cue_edges: false,
             cue_outlier_bound: 2.0,
+            cue_lever_bound: crate::pipeline::MAX_LEVER_STEPS,
             cue_residual_weights: true,
             initial_motion: None,
             newton_iterations: 5,

@@ -14,7 +14,7 @@
 //! there are far larger than `μ` (docs/results.md).
 
 use super::spline_image::SplineImage;
-use super::view_tracking::{PatchTexture, Track, TrackSettings, classified_points, track_warped};
+use super::view_tracking::{PatchTexture, Track, TrackSettings, classified_points, pinning_centres, track_warped};
 use crate::geometry::{Camera, ViewId, pose_at, readout_interval, rs_project};
 use crate::io::{MotionRecord, Raster, Scene};
 use nalgebra::{Matrix3, Vector3};
@@ -59,6 +59,20 @@ const LARGE_PATCH_STEPS: usize = 3;
 /// patches everywhere `checkerboards_slow2` went from 0.068 to 0.028 px and `vegetation_slow2`
 /// from 0.078 to 0.239 px (docs/results.md).
 const MAX_LARGE_PATCH_RESIDUAL: f64 = 0.15;
+
+/// How far apart along x (in grid steps) a patch textured both ways may pin its horizontal and
+/// its vertical displacement ([`pinning_centres`]: the centroids of its squared x and y
+/// gradients) and still give a cue ([`tracked_cues`]; `[stage2] cue_lever_bound`). A cue's
+/// vertical component is the off-row match's vertical displacement, pinned where the patch's
+/// horizontal texture lies, plus `b` times the disparity, pinned where its vertical texture
+/// lies; carried to one point by the disparity gradient, it is off by `b` times the gradient's
+/// error times the distance between the two. What the patch does
+/// not pin of the gradient (the stretch along x of a patch whose vertical texture is one slanted
+/// edge, a checker's corner on a receding floor) comes from its neighbours' plane, which see the
+/// same corner: on the README's scene (512 px, 4 px steps) such cues were off by up to 0.5 px
+/// along their edges, `b`-signed (a tilt), and a bound of one step takes its motion from 0.152
+/// to 0.127 px, 8.9 % of its shift (docs/results.md).
+pub const MAX_LEVER_STEPS: f64 = 1.0;
 
 /// A measured rolling-shutter cue: a textured patch, where it is in the central view, and where
 /// it sits in one off-row view against where its disparity alone would put it.
@@ -125,7 +139,9 @@ pub enum CueAxis {
 /// biases every `μ` the same way. So the tracking is done twice: a first pass gives each patch's
 /// disparity, a plane fitted to its neighbours' gives the local gradient, and the second pass
 /// matches with the deformation that gradient predicts ([`track_warped`]). Patches whose
-/// neighbours fit no plane (a depth edge, a bad match) are left out too.
+/// neighbours fit no plane (a depth edge, a bad match) are left out too, and so are the patches
+/// textured both ways that pin their horizontal and their vertical displacement more than
+/// [`MAX_LEVER_STEPS`] grid steps apart.
 ///
 /// Both matches resample the second view by cubic B-spline ([`SplineImage`]): a cue is a small
 /// fraction of a pixel sideways, where bilinear resampling would carry every match about
@@ -142,21 +158,23 @@ pub enum CueAxis {
 /// pixels): the patches textured both ways whose matches leave over twice the scene's median
 /// share of their contrast give no cue ([`drop_outlying_matches`]).
 pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
-    let mut cues = tracked_cues(scene, guess, views, edges);
+    let mut cues = tracked_cues(scene, guess, views, edges, MAX_LEVER_STEPS);
     let _ = drop_outlying_matches(&mut cues, MAX_RESIDUAL_OVER_MEDIAN);
     cues
 }
 
 /// Every cue [`measure_cues`] tracks, before it leaves out the patches textured both ways whose
-/// matches are outliers ([`drop_outlying_matches`]); each with its [`Cue::residual`].
-pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
+/// matches are outliers ([`drop_outlying_matches`]); each with its [`Cue::residual`]. Patches
+/// textured both ways whose two matches pin their displacements more than `max_lever_steps` grid
+/// steps apart along x give none ([`MAX_LEVER_STEPS`]; 0: no bound).
+pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool, max_lever_steps: f64) -> Vec<Cue> {
     let stride = ((scene.width() * scene.height()) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
     // Patches grow with the grid, so that they cover the same share of the scene at any size:
     // 9 x 9 px up to 256 x 256 (stride 2), 17 x 17 at 512. At 512 px 9 x 9 patches gave
     // 4,714 cues on the README's scene and shared errors of up to 0.03 px a corner; 17 x 17
     // ones 12,495 and 0.004 px (docs/results.md).
-    let base = patch_cues(scene, guess, views, edges, 2 * stride, stride);
-    let large = patch_cues(scene, guess, views, edges, LARGE_PATCH_STEPS * stride, stride);
+    let base = patch_cues(scene, guess, views, edges, 2 * stride, stride, max_lever_steps);
+    let large = patch_cues(scene, guess, views, edges, LARGE_PATCH_STEPS * stride, stride, max_lever_steps);
     prefer_large_patches(base, large)
 }
 
@@ -178,7 +196,15 @@ fn prefer_large_patches(base: Vec<PatchCue>, large: Vec<PatchCue>) -> Vec<Cue> {
 
 /// The cues of the patches of half-size `radius` on the grid of step `stride`, column by column
 /// ([`tracked_cues`]).
-fn patch_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool, radius: usize, stride: usize) -> Vec<PatchCue> {
+fn patch_cues(
+    scene: &Scene,
+    guess: &Raster,
+    views: &[ViewId],
+    edges: bool,
+    radius: usize,
+    stride: usize,
+    max_lever_steps: f64,
+) -> Vec<PatchCue> {
     let grid = scene.grid;
     let (Some(centre), w) = (grid.central(), scene.width()) else { return Vec::new() };
     let settings = TrackSettings { radius, ..TrackSettings::default() };
@@ -240,6 +266,14 @@ fn patch_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool, radi
             .zip(&first.values)
             .filter_map(|(&((x, y), texture), &d1)| {
                 let slope = first.slope_at((x, y), reach)?;
+                // A patch textured both ways only where its two matches pin their displacements
+                // near each other ([`MAX_LEVER_STEPS`]).
+                if texture == PatchTexture::Both && max_lever_steps > 0.0 {
+                    let (along_x, along_y) = pinning_centres(&row_img, (x, y), settings.radius)?;
+                    if (along_y.0 - along_x.0).abs() > max_lever_steps * stride as f64 {
+                        return None;
+                    }
+                }
                 let (d, row_residual) = to_partner((x, y), texture, d1?, slope)?;
                 // The same patch in each view of its column: `b d` rows up or down, and `μ` (its
                 // component across the edges of an edge or a stripe).

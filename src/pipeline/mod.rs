@@ -23,7 +23,8 @@ pub use cue_term::{CueTerm, residual_weights};
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
 pub use measured_cues::{
-    Cue, MAX_RESIDUAL_OVER_MEDIAN, drop_outlying_matches, measure_cues, median_two_way_residual, predicted_cue, tracked_cues,
+    Cue, MAX_LEVER_STEPS, MAX_RESIDUAL_OVER_MEDIAN, drop_outlying_matches, measure_cues, median_two_way_residual, predicted_cue,
+    tracked_cues,
 };
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
@@ -448,7 +449,7 @@ fn stage2(
     let cues = (s.cue_weight > 0.0 || check).then(|| {
         let start = Instant::now();
         let cue_views = stage2_views(scene, s.cue_views);
-        let mut cues = tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges);
+        let mut cues = tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges, s.cue_lever_bound);
         let tracked = cues.len();
         let bound = drop_outlying_matches(&mut cues, s.cue_outlier_bound);
         let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
@@ -465,6 +466,12 @@ fn stage2(
                 "stage 2 cues left out: {} of {tracked} tracked, patches textured both ways whose matches leave over {bound:.3} of their contrast unexplained ({} times the median)",
                 tracked - cues.len(),
                 s.cue_outlier_bound
+            ));
+        }
+        if s.cue_lever_bound > 0.0 {
+            log.push(format!(
+                "stage 2 cues not tracked: patches textured both ways whose two matches pin their displacements over {} grid steps apart",
+                s.cue_lever_bound
             ));
         }
         cues

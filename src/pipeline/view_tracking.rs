@@ -155,6 +155,22 @@ fn larger_eigenvector((a, b, c): (f64, f64, f64), large: f64) -> (f64, f64) {
     if n > 0.0 { (x / n, y / n) } else { (1.0, 0.0) }
 }
 
+/// Where the patch of half-size `radius` at `at` pins a displacement along x and along y: the
+/// offsets from its centre of the centroids of its squared horizontal and vertical gradients.
+pub fn pinning_centres(grey: &Raster, at: (usize, usize), radius: usize) -> Option<((f64, f64), (f64, f64))> {
+    let (mut wx, mut xx, mut xy, mut wy, mut yx, mut yy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for (ox, oy, _, gx, gy) in patch(grey, at.0, at.1, radius)? {
+        let (a, b) = (gx * gx, gy * gy);
+        wx += a;
+        xx += a * ox;
+        xy += a * oy;
+        wy += b;
+        yx += b * ox;
+        yy += b * oy;
+    }
+    (wx > 0.0 && wy > 0.0).then(|| ((xx / wx, xy / wx), (yx / wy, yy / wy)))
+}
+
 /// Tracks the patch of the grey image `from` centred on the integer pixel `at` into `to` (the
 /// spline of an image of the same size), starting at displacement `guess`. `None` when the
 /// patch is flat or leaves either image, the iteration does not settle, or it ends farther than
@@ -304,6 +320,19 @@ mod tests {
         let miss = |d: (f64, f64)| (d.0 - shift.0).hypot(d.1 - shift.1);
         assert!(miss(warped) < 0.02, "warped {warped:?}");
         assert!(miss(plain) > 3.0 * miss(warped), "translation only {plain:?}, warped {warped:?}");
+    }
+
+    #[test]
+    fn a_corner_pins_its_horizontal_displacement_on_one_edge_and_its_vertical_on_the_other() {
+        // A dark quadrant whose vertical edge runs down x = 27 (5 px left of the patch centre)
+        // from y = 30 and whose horizontal edge runs along y = 30 from x = 27 rightwards.
+        let corner = Raster::from_f64_fn(64, 64, |x, y| {
+            let step = |t: f64| 0.5 * (1.0 + (2.0 * t).tanh());
+            0.2 + 0.6 * step(x - 27.0) * step(y - 30.0)
+        });
+        let (along_x, along_y) = pinning_centres(&corner, (32, 32), 8).unwrap();
+        assert!((along_x.0 + 5.0).abs() < 0.2 && along_x.1 > 2.0, "{along_x:?}");
+        assert!((along_y.1 + 2.0).abs() < 0.2 && along_y.0 > 1.0, "{along_y:?}");
     }
 
     #[test]
