@@ -470,7 +470,7 @@ fn stage2(
         }
         if s.cue_lever_bound > 0.0 {
             log.push(format!(
-                "stage 2 cues not tracked: patches textured both ways whose two matches pin their displacements over {} grid steps apart",
+                "stage 2 cues not tracked: patches textured both ways whose two matches pin their displacements over {} x the tracking grid's step apart",
                 s.cue_lever_bound
             ));
         }
