@@ -158,24 +158,45 @@ pub enum CueAxis {
 /// pixels): the patches textured both ways whose matches leave over twice the scene's median
 /// share of their contrast give no cue ([`drop_outlying_matches`]).
 pub fn measure_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool) -> Vec<Cue> {
-    let mut cues = tracked_cues(scene, guess, views, edges, MAX_LEVER_STEPS);
+    let mut cues = tracked_cues(scene, guess, views, edges, MAX_LEVER_STEPS).cues;
     let _ = drop_outlying_matches(&mut cues, MAX_RESIDUAL_OVER_MEDIAN);
     cues
+}
+
+/// What [`tracked_cues`] found: the cues, and how many patches the lever bound left out.
+#[derive(Debug, Clone, Default)]
+pub struct TrackedCues {
+    /// Every cue tracked, before [`drop_outlying_matches`].
+    pub cues: Vec<Cue>,
+    /// The base patches textured both ways that reached the lever bound, summed over columns.
+    pub base_lever: LeverTally,
+    /// The larger patches (`LARGE_PATCH_STEPS`) likewise.
+    pub large_lever: LeverTally,
+}
+
+/// Patches textured both ways that the lever bound ([`MAX_LEVER_STEPS`]) judged, and those it
+/// left out.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LeverTally {
+    /// Patches textured both ways with a local plane, so judged by the bound.
+    pub judged: usize,
+    /// Those whose two matches pin their displacements too far apart: they give no cue.
+    pub left_out: usize,
 }
 
 /// Every cue [`measure_cues`] tracks, before it leaves out the patches textured both ways whose
 /// matches are outliers ([`drop_outlying_matches`]); each with its [`Cue::residual`]. Patches
 /// textured both ways whose two matches pin their displacements more than `max_lever_steps` grid
-/// steps apart along x give none ([`MAX_LEVER_STEPS`]; 0: no bound).
-pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool, max_lever_steps: f64) -> Vec<Cue> {
+/// steps apart along x give none ([`MAX_LEVER_STEPS`]; 0: no bound, and nothing judged).
+pub fn tracked_cues(scene: &Scene, guess: &Raster, views: &[ViewId], edges: bool, max_lever_steps: f64) -> TrackedCues {
     let stride = ((scene.width() * scene.height()) as f64 / 16384.0).sqrt().round().max(2.0) as usize;
     // Patches grow with the grid, so that they cover the same share of the scene at any size:
     // 9 x 9 px up to 256 x 256 (stride 2), 17 x 17 at 512. At 512 px 9 x 9 patches gave
     // 4,714 cues on the README's scene and shared errors of up to 0.03 px a corner; 17 x 17
     // ones 12,495 and 0.004 px (docs/results.md).
-    let base = patch_cues(scene, guess, views, edges, 2 * stride, stride, max_lever_steps);
-    let large = patch_cues(scene, guess, views, edges, LARGE_PATCH_STEPS * stride, stride, max_lever_steps);
-    prefer_large_patches(base, large)
+    let (base, base_lever) = patch_cues(scene, guess, views, edges, 2 * stride, stride, max_lever_steps);
+    let (large, large_lever) = patch_cues(scene, guess, views, edges, LARGE_PATCH_STEPS * stride, stride, max_lever_steps);
+    TrackedCues { cues: prefer_large_patches(base, large), base_lever, large_lever }
 }
 
 /// A cue with the grid point of the central-row view whose patch gave it.
@@ -195,7 +216,7 @@ fn prefer_large_patches(base: Vec<PatchCue>, large: Vec<PatchCue>) -> Vec<Cue> {
 }
 
 /// The cues of the patches of half-size `radius` on the grid of step `stride`, column by column
-/// ([`tracked_cues`]).
+/// ([`tracked_cues`]), and the lever bound's tally over the columns.
 fn patch_cues(
     scene: &Scene,
     guess: &Raster,
@@ -204,11 +225,12 @@ fn patch_cues(
     radius: usize,
     stride: usize,
     max_lever_steps: f64,
-) -> Vec<PatchCue> {
+) -> (Vec<PatchCue>, LeverTally) {
     let grid = scene.grid;
-    let (Some(centre), w) = (grid.central(), scene.width()) else { return Vec::new() };
+    let (Some(centre), w) = (grid.central(), scene.width()) else { return (Vec::new(), LeverTally::default()) };
     let settings = TrackSettings { radius, ..TrackSettings::default() };
     let mut cues = Vec::new();
+    let mut lever = LeverTally::default();
     // The views column by column: those of a column are tracked from the same row view.
     let views: Vec<ViewId> = views.iter().copied().filter(|v| v.row != centre.row && v.col != centre.col).collect();
     let mut columns: Vec<usize> = views.iter().map(|v| v.col).collect();
@@ -261,20 +283,26 @@ fn patch_cues(
         let first = PatchDisparities::new(&points, first, stride);
         // The neighbours a gradient is fitted to: those within a patch (two grid steps).
         let reach = settings.radius;
-        let found: Vec<Vec<PatchCue>> = patches
+        // Each patch's cues, and whether the lever bound judged it (`Some`) and left it out
+        // (`Some(true)`).
+        let found: Vec<(Vec<PatchCue>, Option<bool>)> = patches
             .par_iter()
             .zip(&first.values)
             .filter_map(|(&((x, y), texture), &d1)| {
                 let slope = first.slope_at((x, y), reach)?;
                 // A patch textured both ways only where its two matches pin their displacements
                 // near each other ([`MAX_LEVER_STEPS`]).
+                let mut judged = None;
                 if texture == PatchTexture::Both && max_lever_steps > 0.0 {
                     let (along_x, along_y) = pinning_centres(&row_img, (x, y), settings.radius)?;
                     if (along_y.0 - along_x.0).abs() > max_lever_steps * stride as f64 {
-                        return None;
+                        return Some((Vec::new(), Some(true)));
                     }
+                    judged = Some(false);
                 }
-                let (d, row_residual) = to_partner((x, y), texture, d1?, slope)?;
+                let Some((d, row_residual)) = d1.and_then(|d1| to_partner((x, y), texture, d1, slope)) else {
+                    return Some((Vec::new(), judged));
+                };
                 // The same patch in each view of its column: `b d` rows up or down, and `μ` (its
                 // component across the edges of an edge or a stripe).
                 let in_views = targets.iter().filter_map(|(view, image)| {
@@ -290,12 +318,16 @@ fn patch_cues(
                         Cue { at: (x as f64 + a * d, y as f64), disparity: d, view: *view, offset: (dx, dy + b * d), across, residual },
                     ))
                 });
-                Some(in_views.collect())
+                Some((in_views.collect(), judged))
             })
             .collect();
-        cues.extend(found.into_iter().flatten());
+        for (patch_cues, judged) in found {
+            lever.judged += usize::from(judged.is_some());
+            lever.left_out += usize::from(judged == Some(true));
+            cues.extend(patch_cues);
+        }
     }
-    cues
+    (cues, lever)
 }
 
 /// Leaves out the cues of patches textured both ways whose matches leave more than

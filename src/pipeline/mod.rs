@@ -23,8 +23,8 @@ pub use cue_term::{CueTerm, residual_weights};
 pub use gaussian_init::{frequency_map, sample_gaussians};
 pub use light_field::{Moment, motion_of_record, render_light_field};
 pub use measured_cues::{
-    Cue, MAX_LEVER_STEPS, MAX_RESIDUAL_OVER_MEDIAN, drop_outlying_matches, measure_cues, median_two_way_residual, predicted_cue,
-    tracked_cues,
+    Cue, LeverTally, MAX_LEVER_STEPS, MAX_RESIDUAL_OVER_MEDIAN, TrackedCues, drop_outlying_matches, measure_cues, median_two_way_residual,
+    predicted_cue, tracked_cues,
 };
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
@@ -449,7 +449,8 @@ fn stage2(
     let cues = (s.cue_weight > 0.0 || check).then(|| {
         let start = Instant::now();
         let cue_views = stage2_views(scene, s.cue_views);
-        let mut cues = tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges, s.cue_lever_bound);
+        let TrackedCues { mut cues, base_lever, large_lever } =
+            tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges, s.cue_lever_bound);
         let tracked = cues.len();
         let bound = drop_outlying_matches(&mut cues, s.cue_outlier_bound);
         let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
@@ -470,8 +471,8 @@ fn stage2(
         }
         if s.cue_lever_bound > 0.0 {
             log.push(format!(
-                "stage 2 cues not tracked: patches textured both ways whose two matches pin their displacements over {} x the tracking grid's step apart",
-                s.cue_lever_bound
+                "stage 2 cues not tracked: {} of {} base and {} of {} larger patches textured both ways, whose two matches pin their displacements over {} x the tracking grid's step apart",
+                base_lever.left_out, base_lever.judged, large_lever.left_out, large_lever.judged, s.cue_lever_bound
             ));
         }
         cues
