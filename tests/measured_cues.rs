@@ -71,8 +71,8 @@ fn the_lever_bound_judges_only_patches_textured_both_ways_and_says_how_many_it_l
     let corners = scene.grid.corners();
     let free = tracked_cues(&scene, &guess, &corners, false, 0.0);
     let bound = tracked_cues(&scene, &guess, &corners, false, MAX_LEVER_STEPS);
-    // No bound judges nothing; the bound judges every patch it could have left out, and leaves
-    // out a share of them, not all or none.
+    // No bound judges nothing; the bound leaves out a share of the patches it judges, at either
+    // size, not all or none.
     assert_eq!((free.base_lever, free.large_lever), (LeverTally::default(), LeverTally::default()));
     for tally in [bound.base_lever, bound.large_lever] {
         assert!(tally.left_out > 0 && tally.left_out < tally.judged, "{tally:?}");

@@ -471,7 +471,7 @@ fn stage2(
         }
         if s.cue_lever_bound > 0.0 {
             log.push(format!(
-                "stage 2 cues not tracked: {} of {} base and {} of {} larger patches textured both ways, whose two matches pin their displacements over {} x the tracking grid's step apart",
+                "stage 2 cues not tracked: {} of {} base and {} of {} larger patches textured both ways pin their two displacements over {} x the tracking grid's step apart",
                 base_lever.left_out, base_lever.judged, large_lever.left_out, large_lever.judged, s.cue_lever_bound
             ));
         }
