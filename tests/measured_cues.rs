@@ -204,8 +204,9 @@ fn the_matches_that_leave_more_of_their_patch_unexplained_are_further_off_the_tr
     // Among those kept, the cue term weighs down the cues whose residual is over the median:
     // they are the further off, and the weighted median of the components' misses is the lower.
     let weights = residual_weights(&kept);
-    let (full, down): (Vec<(&Cue, f64)>, Vec<(&Cue, f64)>) = kept.iter().zip(weights.iter().copied()).partition(|&(_, w)| w >= 1.0);
-    let (full_miss, down_miss) = (miss(&full.iter().map(|p| p.0).collect::<Vec<_>>()), miss(&down.iter().map(|p| p.0).collect::<Vec<_>>()));
+    let weighed = |full: bool| kept.iter().zip(&weights).filter(|&(_, &w)| (w >= 1.0) == full).map(|(c, _)| c).collect::<Vec<_>>();
+    let (full, down) = (weighed(true), weighed(false));
+    let (full_miss, down_miss) = (miss(&full), miss(&down));
     let mut misses: Vec<(f64, f64)> =
         kept.iter().zip(&weights).flat_map(|(c, &w)| [(c.offset.0.abs(), w), (c.offset.1.abs(), w)]).collect();
     misses.sort_by(|a, b| a.0.total_cmp(&b.0));

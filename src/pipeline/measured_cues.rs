@@ -61,7 +61,7 @@ const LARGE_PATCH_STEPS: usize = 3;
 const MAX_LARGE_PATCH_RESIDUAL: f64 = 0.15;
 
 /// How far apart along x (in grid steps) a patch textured both ways may pin its horizontal and
-/// its vertical displacement ([`pinning_centres`]: the centroids of its squared x and y
+/// its vertical displacement (`pinning_centres`: the centroids of its squared x and y
 /// gradients) and still give a cue ([`tracked_cues`]; `[stage2] cue_lever_bound`). A cue's
 /// vertical component is the off-row match's vertical displacement, pinned where the patch's
 /// horizontal texture lies, plus `b` times the disparity, pinned where its vertical texture
@@ -138,7 +138,7 @@ pub enum CueAxis {
 /// horizontal match that gives `d` and the vertical one that gives `μ`: on a receding floor that
 /// biases every `μ` the same way. So the tracking is done twice: a first pass gives each patch's
 /// disparity, a plane fitted to its neighbours' gives the local gradient, and the second pass
-/// matches with the deformation that gradient predicts ([`track_warped`]). Patches whose
+/// matches with the deformation that gradient predicts (`track_warped`). Patches whose
 /// neighbours fit no plane (a depth edge, a bad match) are left out too, and so are the patches
 /// textured both ways that pin their horizontal and their vertical displacement more than
 /// [`MAX_LEVER_STEPS`] grid steps apart.

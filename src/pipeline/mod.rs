@@ -1,5 +1,8 @@
-//! The RSLF composition: stage-1 initialisation (plane sweep, Gaussian sampling), stage-1 fit,
-//! then stage 2 (motion) as it arrives, and the result.
+//! The RSLF composition: stage 1 (initial disparity, Gaussian sampling, fit: `stage1.rs`), then
+//! stage 2 (the motion: `stage2.rs`) where the scene allows it, and the result, with the settings
+//! both draw from a config. The optimisation loops are `stage1_fit.rs` and `stage2_fit.rs`; the
+//! cues stage 2 measures between the views and weighs are `measured_cues.rs`, `cue_support.rs` and
+//! `cue_term.rs`.
 
 mod aperture;
 mod box_filter;
@@ -10,8 +13,11 @@ mod light_field;
 mod measured_cues;
 mod plane_sweep;
 mod results;
+mod run_log;
 mod spline_image;
+mod stage1;
 mod stage1_fit;
+mod stage2;
 mod stage2_fit;
 mod targets;
 mod view_tracking;
@@ -28,6 +34,7 @@ pub use measured_cues::{
 };
 pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
+pub use run_log::RunLog;
 pub use spline_image::SplineImage;
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
 pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales, pose_table};
@@ -38,56 +45,14 @@ use crate::config::{Config, TimingChoice, ViewSelection};
 use crate::device::host_values;
 use crate::geometry::{Camera, TensorCamera, ViewId, readout_interval};
 use crate::io::{MotionRecord, Raster, Scene};
-use crate::loss::{LossRegistry, WeightedLosses};
+use crate::loss::LossRegistry;
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
-use crate::optim::NewtonSettings;
-use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, row_bands, splat};
+use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, splat};
 use burn::tensor::{Device, Tensor, TensorData};
-use std::time::Instant;
-
-/// Residual (px) beyond which a measured cue counts linearly in the cue term.
-const CUE_HUBER_PX: f32 = 0.1;
-
-/// Finite-difference step (scaled units: about a pixel of image motion each) of the stage-2
-/// Newton steps' Hessian, and their longest step.
-const NEWTON_FD_STEP: f64 = 0.05;
-const NEWTON_MAX_STEP: f64 = 2.0;
-/// The stage-2 Newton steps hold the directions whose curvature is under this share of the
-/// steepest's. On the 256 px suite the two flattest (about 1/300 of the steepest, mostly the
-/// motion prior's own curvature: tilt against vertical translation, pan against sideways
-/// translation) carried the steps that made the slow scenes worse, while the roll and v_z
-/// directions (1/80 and more) carried the gains (docs/results.md).
-const NEWTON_MIN_CURVATURE_RATIO: f64 = 5e-3;
 
 /// Opacity above which a rendered pixel's blended disparity is trusted over the initial map.
 const TRUSTED_ALPHA: f32 = 0.5;
-
-/// Which stages a run carried out, for the user and the logs.
-#[derive(Debug, Clone, Default)]
-pub struct RunLog {
-    /// One line per stage: what ran, with its figures, or why it did not.
-    pub lines: Vec<String>,
-    /// Whether each line is also printed to standard output as it is added.
-    echo: bool,
-}
-
-impl RunLog {
-    /// A log that prints each line as it comes, so that a long run shows where it is even with
-    /// its output going to a file (the progress bars draw only on a terminal).
-    pub fn printing() -> Self {
-        Self { lines: Vec::new(), echo: true }
-    }
-
-    /// Adds a line (and prints it, for a [`RunLog::printing`] log).
-    pub fn push(&mut self, line: impl Into<String>) {
-        let line = line.into();
-        if self.echo {
-            outln!("{line}");
-        }
-        self.lines.push(line);
-    }
-}
 
 /// The plane-sweep settings a config gives for a scene: the config's range, else the scene's
 /// `[meta]` range, else [-4, 4] pixels.
@@ -270,7 +235,7 @@ pub fn run_logged(
         }
         None => None,
     };
-    let (gaussians, initial, mut curves) = stage1(config, scene, &stage1_losses, device, &mut log)?;
+    let (gaussians, initial, mut curves) = stage1::run(config, scene, &stage1_losses, device, &mut log)?;
     let render = render_settings(config);
 
     let initial_motion = match &config.stage2.initial_motion {
@@ -305,7 +270,7 @@ pub fn run_logged(
             }
             // The stage-1 geometry the disocclusion masks come from, rendered only when they are asked for.
             let stage1_disparity = config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
-            let fitted = stage2(
+            let fitted = stage2::run(
                 config,
                 scene,
                 cam,
@@ -351,357 +316,4 @@ pub fn run_logged(
     };
     let result = RunResult { disparity, central, motion, gaussians: Some(gaussians.to_set()), points, curves };
     Ok((result, log))
-}
-
-/// Stage 1: plane sweep, sampling and fit. Returns the Gaussians, the initial disparity map
-/// (the fallback where the render is transparent) and the loss curve.
-fn stage1(
-    config: &Config,
-    scene: &Scene,
-    losses: &WeightedLosses,
-    device: &Device,
-    log: &mut RunLog,
-) -> crate::Result<(Gaussians, Raster, LossCurves)> {
-    let initial = match &config.stage1.initial_disparity {
-        Some(path) => {
-            let map = crate::io::read_pfm(path)?;
-            if (map.width, map.height) != (scene.width(), scene.height()) {
-                return Err(crate::Error::Usage(format!(
-                    "config: stage1.initial_disparity {} is {}x{}, the views are {}x{}",
-                    path.display(),
-                    map.width,
-                    map.height,
-                    scene.width(),
-                    scene.height()
-                )));
-            }
-            log.push(format!("stage 1 initialisation: disparity from {}", path.display()));
-            map
-        }
-        None => sweep(config, scene, log),
-    };
-    let start = Instant::now();
-    let set = sample_gaussians(scene.central(), &initial, config.stage1.gaussians, config.seed);
-    let mut gaussians = set.to_module(device);
-    log.push(format!("stage 1 sampling: {} Gaussians, {:.1} s", set.len(), start.elapsed().as_secs_f64()));
-
-    let views = stage1_views(scene, config.stage1.views, column_views(config, scene));
-    let mut curves = Vec::new();
-    if config.stage1.iterations > 0 {
-        let s = &config.stage1;
-        let fit = Stage1Fit {
-            iterations: s.iterations,
-            band_height: s.band_height,
-            adam_epsilon: s.adam_epsilon as f32,
-            lr: LearningRates { position: s.lr_position, disparity: s.lr_disparity, size: s.lr_size, colour: s.lr_colour },
-            render: render_settings(config),
-        };
-        let bar = crate::progress::bar(s.iterations as u64, "stage 1: fit");
-        let start = Instant::now();
-        let (fitted, curve) = fit_stage1(gaussians, scene, &views, &fit, losses, device, |done, _, loss| {
-            bar.set_position(done as u64);
-            bar.set_message(format!("stage 1: loss {loss:.4}"));
-        });
-        bar.finish_and_clear();
-        gaussians = fitted;
-        // Bands are taken in turn, one a step: a round of them is one pass over the views.
-        let ends = curve_ends(&curve, row_bands(0..scene.height(), s.band_height).len());
-        log.push(format!(
-            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4} over the first and the last round of bands, {:.1} s",
-            s.iterations,
-            s.band_height,
-            views.iter().filter(|v| v.row == scene.central_id().row).count(),
-            views.iter().filter(|v| v.row != scene.central_id().row).count(),
-            losses.names().join(" + "),
-            ends.0,
-            ends.1,
-            start.elapsed().as_secs_f64()
-        ));
-        curves.push(("stage1".to_string(), curve));
-    }
-    Ok((gaussians, initial, curves))
-}
-
-/// Stage 2: the motion, fitted against the off-row views and checked against the cues measured
-/// between them. With the check on, the measured-cue term (`cue_weight`) joins only after it:
-/// the photometric fit alone is judged (a fit to the cues would pass any check against them). A
-/// motion the cues confirm is fitted again from the start, with the term; one they do not
-/// confirm is set to none (a still camera unless the cues show otherwise). The loss curves go to
-/// `curves`: `stage2`, then `stage2_cues` when the second fit runs.
-#[allow(clippy::too_many_arguments)]
-fn stage2(
-    config: &Config,
-    scene: &Scene,
-    camera: &Camera,
-    model: &dyn MotionModel,
-    gaussians: Gaussians,
-    start_values: &[f64],
-    losses: &WeightedLosses,
-    device: &Device,
-    stage1_disparity: Option<&Raster>,
-    initial_disparity: &Raster,
-    log: &mut RunLog,
-    curves: &mut LossCurves,
-) -> MotionFit {
-    let s = &config.stage2;
-    // The cue check judges a fitted motion; a motion given with no iterations is used as it is.
-    let check = s.min_cue_support > 0.0 && s.iterations > 0;
-    let cues = (s.cue_weight > 0.0 || check).then(|| {
-        let start = Instant::now();
-        let cue_views = stage2_views(scene, s.cue_views);
-        let TrackedCues { mut cues, base_lever, large_lever } =
-            tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges, s.cue_lever_bound);
-        let tracked = cues.len();
-        let bound = drop_outlying_matches(&mut cues, s.cue_outlier_bound);
-        let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
-        log.push(format!(
-            "stage 2 cues: {} measured in {} views off the central row and column ({:?}), {} of them across an edge or a stripe only, textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
-            cues.len(),
-            measured_in.len(),
-            s.cue_views,
-            cues.iter().filter(|c| c.across.is_some()).count(),
-            start.elapsed().as_secs_f64()
-        ));
-        if let Some(bound) = bound {
-            log.push(format!(
-                "stage 2 cues left out: {} of {tracked} tracked, patches textured both ways whose matches leave over {bound:.3} of their contrast unexplained ({} times the median)",
-                tracked - cues.len(),
-                s.cue_outlier_bound
-            ));
-        }
-        if s.cue_lever_bound > 0.0 {
-            log.push(format!(
-                "stage 2 cues not tracked: {} of {} base and {} of {} larger patches textured both ways pin their two displacements over {} x the tracking grid's step apart",
-                base_lever.left_out, base_lever.judged, large_lever.left_out, large_lever.judged, s.cue_lever_bound
-            ));
-        }
-        cues
-    });
-    // The term is built where a fit uses it: a motion the check sets to none needs none.
-    let cue_term = || {
-        cues.as_ref()
-            .filter(|_| s.cue_weight > 0.0)
-            .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, s.cue_residual_weights, device))
-    };
-    let mut views = stage2_views(scene, s.views);
-    if s.views == ViewSelection::Corners && views != scene.grid.corners() {
-        let names: Vec<String> = views.iter().map(|&v| scene.grid.index(v).to_string()).collect();
-        log.push(format!(
-            "stage 2 views: the grid's four corners are not all present; views {} stand in for them (each quadrant's outermost)",
-            names.join(", ")
-        ));
-    }
-    let refine = (s.refine_gaussians > 0.0).then(|| {
-        let (k, s1) = (s.refine_gaussians, &config.stage1);
-        views.extend(stage1_views(scene, s1.views, column_views(config, scene)));
-        let lr =
-            LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
-        (lr, s1.adam_epsilon as f32)
-    });
-    let fit = Stage2Fit {
-        iterations: s.iterations,
-        timing: rs_timing(config),
-        band_height: s.band_height,
-        bands_per_step: s.bands_per_step,
-        lr: s.lr,
-        lr_final: s.lr_final,
-        adam_epsilon: s.adam_epsilon as f32,
-        seed: config.seed,
-        render: render_settings(config),
-        refine,
-        disocclusion_margin: s.mask_disocclusions.then_some(s.disocclusion_margin),
-        aperture_weighting: s.aperture_weighting,
-        // No Adam steps, no estimation: a given `initial_motion` is used as it is.
-        newton: NewtonSettings {
-            iterations: if s.iterations > 0 { s.newton_iterations } else { 0 },
-            fd_step: NEWTON_FD_STEP,
-            max_step: NEWTON_MAX_STEP,
-            min_curvature_ratio: NEWTON_MIN_CURVATURE_RATIO,
-        },
-    };
-    // One phase of the fit, with its progress bar and its line in the log. The Newton steps go to
-    // the last (`last`), whose motion is kept: the second when the check may confirm the motion
-    // for one, so the check judges the same fit with or without them.
-    let phase = |what: &str, g: Gaussians, cue_term: Option<&CueTerm>, last: bool, log: &mut RunLog| {
-        let bar = crate::progress::bar(s.iterations as u64, &format!("stage 2: {what}"));
-        let start = Instant::now();
-        let fit = if last { fit.clone() } else { Stage2Fit { newton: NewtonSettings { iterations: 0, ..fit.newton }, ..fit.clone() } };
-        let fitted = fit_stage2(
-            g,
-            scene,
-            camera,
-            &views,
-            model,
-            start_values,
-            &fit,
-            losses,
-            device,
-            stage1_disparity,
-            cue_term,
-            |done, of, loss| {
-                bar.set_position(done.min(of) as u64);
-                bar.set_message(match done.checked_sub(of).filter(|&k| k > 0) {
-                    None => format!("stage 2 ({what}): loss {loss:.4}"),
-                    Some(k) => format!("stage 2 ({what}): Newton steps, objective {loss:.5} ({k} evaluations)"),
-                });
-            },
-        );
-        bar.finish_and_clear();
-        // Each step scores `bands_per_step` bands drawn across the image.
-        let bands = row_bands(0..scene.height(), s.band_height).len();
-        let stage2_ends = curve_ends(&fitted.curve, bands.div_ceil(s.bands_per_step.clamp(1, bands.max(1))));
-        log.push(format!(
-            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}, {:.1} s; estimate {}",
-            model.name(),
-            s.iterations,
-            s.bands_per_step,
-            s.band_height,
-            views.len(),
-            s.timing,
-            if fit.disocclusion_margin.is_some() {
-                format!("{:.1}% of the pixels compared (disocclusions masked)", 100.0 * fitted.kept)
-            } else {
-                "every pixel compared".to_string()
-            },
-            if fit.aperture_weighting { ", off-row pixels weighted by their horizontal gradient share" } else { "" },
-            cue_term.map_or(String::new(), |c| format!(", measured-cue term ×{} over {} cues", c.weight, c.len)),
-            losses.names().join(" + "),
-            stage2_ends.0,
-            stage2_ends.1,
-            fitted.newton.map_or(String::new(), |r| format!(
-                ", then {} of {} Newton steps taken over every band{}, {:.5} -> {:.5} ({} evaluations)",
-                r.taken,
-                s.newton_iterations,
-                if cue_term.is_some() { " (their objective leaves the motion prior out)" } else { "" },
-                r.start,
-                r.end,
-                r.evaluations
-            )),
-            start.elapsed().as_secs_f64(),
-            estimate_line(model, &fitted.parameters)
-        ));
-        fitted
-    };
-    let checked_cues = cues.as_ref().filter(|_| check);
-    let first_cue_term = if checked_cues.is_some() { None } else { cue_term() };
-    let second_fit = checked_cues.is_some() && s.cue_weight > 0.0;
-    let mut fitted = phase("fit", gaussians.clone(), first_cue_term.as_ref(), !second_fit, log);
-    curves.push(("stage2".to_string(), fitted.curve.clone()));
-    let Some(checked) = checked_cues else { return fitted };
-    // The check judges with the patches textured both ways alone: the cues of edges and stripes
-    // carry biases of a few percent, enough to bear out a still scene's drift
-    // (`objects_static`: 0.55 ± 0.01 with them, -0.01 ± 0.02 without; docs/results.md).
-    let two_way: Vec<Cue> = checked.iter().copied().filter(|c| c.across.is_none()).collect();
-    let confirmed = check_motion(&mut fitted, model, camera, &two_way, s.min_cue_support, log);
-    if let Some(term) = confirmed.then(cue_term).flatten() {
-        // Only a motion the cues clearly show: fitted to the cues, a still scene's drift does not
-        // shrink (the 256 px suite's still scenes end 0.22-0.81 px off; docs/results.md). From the
-        // start again, not from the photometric estimate: started there, the fit stays near it
-        // (objects_accel, constant_acceleration: 1.22 px against 0.51 px).
-        fitted = phase("fit with the measured cues", gaussians, Some(&term), true, log);
-        curves.push(("stage2_cues".to_string(), fitted.curve.clone()));
-    }
-    fitted
-}
-
-/// A motion's parameters as `motion.toml` names them, five significant digits each, for the log:
-/// `omega_rad_s [6.2191e-2, 0, 0], velocity_m_s [0, -2.4877e-1, 0]`.
-fn estimate_line(model: &dyn MotionModel, parameters: &[f64]) -> String {
-    let number = |x: f64| if x == 0.0 { "0".to_string() } else { format!("{x:.4e}") };
-    model
-        .record(parameters)
-        .groups()
-        .into_iter()
-        .map(|(name, values)| format!("{name} [{}]", values.into_iter().map(number).collect::<Vec<_>>().join(", ")))
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
-/// Keeps the fitted motion only when the cues measured between the views confirm it at
-/// `min_support` ([`CueSupport::confirms`]), else sets it to none, and says in the log what they
-/// show either way. A motion they neither refute nor confirm goes too: on the 128 px suite only
-/// still scenes came out so (docs/results.md). Returns whether they confirm it; with too few cues
-/// to judge, the motion is kept as fitted and `false` returned.
-fn check_motion(
-    fitted: &mut MotionFit,
-    model: &dyn MotionModel,
-    camera: &Camera,
-    cues: &[Cue],
-    min_support: f64,
-    log: &mut RunLog,
-) -> bool {
-    let Some(support) = cue_support(camera, &model.record(&fitted.parameters), cues) else {
-        log.push(format!("stage 2 check: not made ({} measured cues; at least 100 imaged and a motion are needed)", cues.len()));
-        return false;
-    };
-    let shown = format!(
-        "the {} measured cues of patches textured both ways bear out {:.2} (± {:.2}) of the motion's predicted ones",
-        support.cues, support.share, support.standard_error
-    );
-    if support.confirms(min_support) {
-        log.push(format!("stage 2 check: {shown}, clearly over {min_support}: kept"));
-        return true;
-    }
-    fitted.parameters.iter_mut().for_each(|p| *p = 0.0);
-    let verdict = if support.refutes(min_support) { "clearly under" } else { "not clearly over" };
-    log.push(format!("stage 2 check: {shown}, {verdict} {min_support}: taken for a drift of the fit, no motion kept"));
-    false
-}
-
-/// The mean loss of a fit's first and last `round` steps (NaN for an empty curve). Each step
-/// scores some bands of rows only, so one step's loss against another's compares different
-/// rows: a stage-1 fit at 512 px read 0.044 -> 0.050 (its top band against its fourth) while
-/// every band's loss fell 2-3x, the round's mean 0.093 -> 0.040. A round of steps covers the
-/// image.
-fn curve_ends(curve: &[f32], round: usize) -> (f32, f32) {
-    let n = round.max(1).min(curve.len());
-    let mean = |steps: &[f32]| if steps.is_empty() { f32::NAN } else { steps.iter().sum::<f32>() / steps.len() as f32 };
-    (mean(&curve[..n]), mean(&curve[curve.len() - n..]))
-}
-
-/// The plane sweep over the central row (and the stage-1 views of the central column): the
-/// initial disparity map.
-fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster {
-    let settings = sweep_settings(config, scene);
-    let row_views = scene.central_row_views();
-    let column = stage1_views(scene, 0, column_views(config, scene));
-    let views: Vec<ViewId> = row_views.iter().chain(&column).copied().collect();
-    let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
-    let bar = crate::progress::bar(labels, "stage 1: sweep");
-    let start = Instant::now();
-    let estimate = plane_sweep(scene, &views, &settings, |done, _| bar.set_position(done as u64));
-    bar.finish_and_clear();
-    log.push(format!(
-        "stage 1 initialisation: plane sweep over {} central-row and {} central-column views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
-        row_views.len(),
-        column.len(),
-        settings.range.0,
-        settings.range.1,
-        labels,
-        start.elapsed().as_secs_f64()
-    ));
-
-    estimate.disparity
-}
-
-#[cfg(test)]
-mod tests {
-    use super::{curve_ends, row_bands};
-
-    #[test]
-    fn a_round_of_bands_compares_the_whole_image_at_both_ends() {
-        // Four bands taken in turn, each loss falling by half over three rounds, the last band
-        // the hardest: its last step reads higher than the first band's first step.
-        let per_band = [0.1_f32, 0.2, 0.3, 0.8];
-        let curve: Vec<f32> = (0..12).map(|step| per_band[step % 4] * 0.5_f32.powi((step / 4) as i32)).collect();
-        assert!(curve[11] > curve[0]);
-        let (first, last) = curve_ends(&curve, row_bands(0..64, 16).len());
-        assert!((first - 0.35).abs() < 1e-6 && (last - 0.0875).abs() < 1e-6, "{first} -> {last}");
-        // A curve shorter than a round is compared with itself; an empty one gives NaN.
-        let (a, b) = curve_ends(&curve[..3], 4);
-        assert!(a == b && (a - 0.2).abs() < 1e-6, "{a} -> {b}");
-        assert!(curve_ends(&[], 4).0.is_nan());
-        assert_eq!(row_bands(0..100, 16).len(), 7);
-        assert_eq!(row_bands(0..100, 0).len(), 100);
-    }
 }

@@ -45,7 +45,7 @@ pub struct Stage2Fit {
     /// as in stage 1), against the same views.
     pub refine: Option<(LearningRates, f32)>,
     /// When set, the pixels of each view that no pixel of the central view reaches, widened by
-    /// this many pixels, are left out of the loss (see [`explained_mask_moving`]).
+    /// this many pixels, are left out of the loss (see `explained_mask_moving`).
     pub disocclusion_margin: Option<usize>,
     /// Weigh the pixels of the views off the central row by [`aperture_weights`] in the motion's
     /// residual, so that residuals a disparity error could equally have caused do not pull the

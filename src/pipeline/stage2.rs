@@ -1,0 +1,246 @@
+//! Stage 2 as a run carries it out: the cues measured between the views, the photometric fit of
+//! the motion ([`super::fit_stage2`]), the check of its estimate against the cues, and the fit
+//! again with them of a motion they confirm, each with its line in the run's log.
+
+use super::run_log::{RunLog, curve_ends, estimate_line};
+use super::{
+    Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Fit, TrackedCues, column_views, cue_support, drop_outlying_matches,
+    fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
+};
+use crate::config::{Config, ViewSelection};
+use crate::geometry::{Camera, ViewId};
+use crate::io::{Raster, Scene};
+use crate::loss::WeightedLosses;
+use crate::model::Gaussians;
+use crate::model::motion::MotionModel;
+use crate::optim::NewtonSettings;
+use crate::render::row_bands;
+use burn::tensor::Device;
+use std::time::Instant;
+
+/// Residual (px) beyond which a measured cue counts linearly in the cue term.
+const CUE_HUBER_PX: f32 = 0.1;
+
+/// Finite-difference step (scaled units: about a pixel of image motion each) of the stage-2
+/// Newton steps' Hessian, and their longest step.
+const NEWTON_FD_STEP: f64 = 0.05;
+const NEWTON_MAX_STEP: f64 = 2.0;
+/// The stage-2 Newton steps hold the directions whose curvature is under this share of the
+/// steepest's. On the 256 px suite the two flattest (about 1/300 of the steepest, mostly the
+/// motion prior's own curvature: tilt against vertical translation, pan against sideways
+/// translation) carried the steps that made the slow scenes worse, while the roll and v_z
+/// directions (1/80 and more) carried the gains (docs/results.md).
+const NEWTON_MIN_CURVATURE_RATIO: f64 = 5e-3;
+
+/// Stage 2: the motion, fitted against the off-row views and checked against the cues measured
+/// between them. With the check on, the measured-cue term (`cue_weight`) joins only after it:
+/// the photometric fit alone is judged (a fit to the cues would pass any check against them). A
+/// motion the cues confirm is fitted again from the start, with the term; one they do not
+/// confirm is set to none (a still camera unless the cues show otherwise). The loss curves go to
+/// `curves`: `stage2`, then `stage2_cues` when the second fit runs.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn run(
+    config: &Config,
+    scene: &Scene,
+    camera: &Camera,
+    model: &dyn MotionModel,
+    gaussians: Gaussians,
+    start_values: &[f64],
+    losses: &WeightedLosses,
+    device: &Device,
+    stage1_disparity: Option<&Raster>,
+    initial_disparity: &Raster,
+    log: &mut RunLog,
+    curves: &mut LossCurves,
+) -> MotionFit {
+    let s = &config.stage2;
+    // The cue check judges a fitted motion; a motion given with no iterations is used as it is.
+    let check = s.min_cue_support > 0.0 && s.iterations > 0;
+    let cues = (s.cue_weight > 0.0 || check).then(|| {
+        let start = Instant::now();
+        let cue_views = stage2_views(scene, s.cue_views);
+        let TrackedCues { mut cues, base_lever, large_lever } =
+            tracked_cues(scene, initial_disparity, &cue_views, s.cue_edges, s.cue_lever_bound);
+        let tracked = cues.len();
+        let bound = drop_outlying_matches(&mut cues, s.cue_outlier_bound);
+        let measured_in: std::collections::BTreeSet<ViewId> = cues.iter().map(|c| c.view).collect();
+        log.push(format!(
+            "stage 2 cues: {} measured in {} views off the central row and column ({:?}), {} of them across an edge or a stripe only, textured patches of the central-row view of each one's column tracked into the farthest view of the central row and into it, {:.1} s",
+            cues.len(),
+            measured_in.len(),
+            s.cue_views,
+            cues.iter().filter(|c| c.across.is_some()).count(),
+            start.elapsed().as_secs_f64()
+        ));
+        if let Some(bound) = bound {
+            log.push(format!(
+                "stage 2 cues left out: {} of {tracked} tracked, patches textured both ways whose matches leave over {bound:.3} of their contrast unexplained ({} times the median)",
+                tracked - cues.len(),
+                s.cue_outlier_bound
+            ));
+        }
+        if s.cue_lever_bound > 0.0 {
+            log.push(format!(
+                "stage 2 cues not tracked: {} of {} base and {} of {} larger patches textured both ways pin their two displacements over {} x the tracking grid's step apart",
+                base_lever.left_out, base_lever.judged, large_lever.left_out, large_lever.judged, s.cue_lever_bound
+            ));
+        }
+        cues
+    });
+    // The term is built where a fit uses it: a motion the check sets to none needs none.
+    let cue_term = || {
+        cues.as_ref()
+            .filter(|_| s.cue_weight > 0.0)
+            .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, s.cue_residual_weights, device))
+    };
+    let mut views = stage2_views(scene, s.views);
+    if s.views == ViewSelection::Corners && views != scene.grid.corners() {
+        let names: Vec<String> = views.iter().map(|&v| scene.grid.index(v).to_string()).collect();
+        log.push(format!(
+            "stage 2 views: the grid's four corners are not all present; views {} stand in for them (each quadrant's outermost)",
+            names.join(", ")
+        ));
+    }
+    let refine = (s.refine_gaussians > 0.0).then(|| {
+        let (k, s1) = (s.refine_gaussians, &config.stage1);
+        views.extend(stage1_views(scene, s1.views, column_views(config, scene)));
+        let lr =
+            LearningRates { position: k * s1.lr_position, disparity: k * s1.lr_disparity, size: k * s1.lr_size, colour: k * s1.lr_colour };
+        (lr, s1.adam_epsilon as f32)
+    });
+    let fit = Stage2Fit {
+        iterations: s.iterations,
+        timing: rs_timing(config),
+        band_height: s.band_height,
+        bands_per_step: s.bands_per_step,
+        lr: s.lr,
+        lr_final: s.lr_final,
+        adam_epsilon: s.adam_epsilon as f32,
+        seed: config.seed,
+        render: render_settings(config),
+        refine,
+        disocclusion_margin: s.mask_disocclusions.then_some(s.disocclusion_margin),
+        aperture_weighting: s.aperture_weighting,
+        // No Adam steps, no estimation: a given `initial_motion` is used as it is.
+        newton: NewtonSettings {
+            iterations: if s.iterations > 0 { s.newton_iterations } else { 0 },
+            fd_step: NEWTON_FD_STEP,
+            max_step: NEWTON_MAX_STEP,
+            min_curvature_ratio: NEWTON_MIN_CURVATURE_RATIO,
+        },
+    };
+    // One phase of the fit, with its progress bar and its line in the log. The Newton steps go to
+    // the last (`last`), whose motion is kept: the second when the check may confirm the motion
+    // for one, so the check judges the same fit with or without them.
+    let phase = |what: &str, g: Gaussians, cue_term: Option<&CueTerm>, last: bool, log: &mut RunLog| {
+        let bar = crate::progress::bar(s.iterations as u64, &format!("stage 2: {what}"));
+        let start = Instant::now();
+        let fit = if last { fit.clone() } else { Stage2Fit { newton: NewtonSettings { iterations: 0, ..fit.newton }, ..fit.clone() } };
+        let fitted = fit_stage2(
+            g,
+            scene,
+            camera,
+            &views,
+            model,
+            start_values,
+            &fit,
+            losses,
+            device,
+            stage1_disparity,
+            cue_term,
+            |done, of, loss| {
+                bar.set_position(done.min(of) as u64);
+                bar.set_message(match done.checked_sub(of).filter(|&k| k > 0) {
+                    None => format!("stage 2 ({what}): loss {loss:.4}"),
+                    Some(k) => format!("stage 2 ({what}): Newton steps, objective {loss:.5} ({k} evaluations)"),
+                });
+            },
+        );
+        bar.finish_and_clear();
+        // Each step scores `bands_per_step` bands drawn across the image.
+        let bands = row_bands(0..scene.height(), s.band_height).len();
+        let stage2_ends = curve_ends(&fitted.curve, bands.div_ceil(s.bands_per_step.clamp(1, bands.max(1))));
+        log.push(format!(
+            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}, {:.1} s; estimate {}",
+            model.name(),
+            s.iterations,
+            s.bands_per_step,
+            s.band_height,
+            views.len(),
+            s.timing,
+            if fit.disocclusion_margin.is_some() {
+                format!("{:.1}% of the pixels compared (disocclusions masked)", 100.0 * fitted.kept)
+            } else {
+                "every pixel compared".to_string()
+            },
+            if fit.aperture_weighting { ", off-row pixels weighted by their horizontal gradient share" } else { "" },
+            cue_term.map_or(String::new(), |c| format!(", measured-cue term ×{} over {} cues", c.weight, c.len)),
+            losses.names().join(" + "),
+            stage2_ends.0,
+            stage2_ends.1,
+            fitted.newton.map_or(String::new(), |r| format!(
+                ", then {} of {} Newton steps taken over every band{}, {:.5} -> {:.5} ({} evaluations)",
+                r.taken,
+                s.newton_iterations,
+                if cue_term.is_some() { " (their objective leaves the motion prior out)" } else { "" },
+                r.start,
+                r.end,
+                r.evaluations
+            )),
+            start.elapsed().as_secs_f64(),
+            estimate_line(model, &fitted.parameters)
+        ));
+        fitted
+    };
+    let checked_cues = cues.as_ref().filter(|_| check);
+    let first_cue_term = if checked_cues.is_some() { None } else { cue_term() };
+    let second_fit = checked_cues.is_some() && s.cue_weight > 0.0;
+    let mut fitted = phase("fit", gaussians.clone(), first_cue_term.as_ref(), !second_fit, log);
+    curves.push(("stage2".to_string(), fitted.curve.clone()));
+    let Some(checked) = checked_cues else { return fitted };
+    // The check judges with the patches textured both ways alone: the cues of edges and stripes
+    // carry biases of a few percent, enough to bear out a still scene's drift
+    // (`objects_static`: 0.55 ± 0.01 with them, -0.01 ± 0.02 without; docs/results.md).
+    let two_way: Vec<Cue> = checked.iter().copied().filter(|c| c.across.is_none()).collect();
+    let confirmed = check_motion(&mut fitted, model, camera, &two_way, s.min_cue_support, log);
+    if let Some(term) = confirmed.then(cue_term).flatten() {
+        // Only a motion the cues clearly show: fitted to the cues, a still scene's drift does not
+        // shrink (the 256 px suite's still scenes end 0.22-0.81 px off; docs/results.md). From the
+        // start again, not from the photometric estimate: started there, the fit stays near it
+        // (objects_accel, constant_acceleration: 1.22 px against 0.51 px).
+        fitted = phase("fit with the measured cues", gaussians, Some(&term), true, log);
+        curves.push(("stage2_cues".to_string(), fitted.curve.clone()));
+    }
+    fitted
+}
+
+/// Keeps the fitted motion only when the cues measured between the views confirm it at
+/// `min_support` ([`CueSupport::confirms`]), else sets it to none, and says in the log what they
+/// show either way. A motion they neither refute nor confirm goes too: on the 128 px suite only
+/// still scenes came out so (docs/results.md). Returns whether they confirm it; with too few cues
+/// to judge, the motion is kept as fitted and `false` returned.
+pub(super) fn check_motion(
+    fitted: &mut MotionFit,
+    model: &dyn MotionModel,
+    camera: &Camera,
+    cues: &[Cue],
+    min_support: f64,
+    log: &mut RunLog,
+) -> bool {
+    let Some(support) = cue_support(camera, &model.record(&fitted.parameters), cues) else {
+        log.push(format!("stage 2 check: not made ({} measured cues; at least 100 imaged and a motion are needed)", cues.len()));
+        return false;
+    };
+    let shown = format!(
+        "the {} measured cues of patches textured both ways bear out {:.2} (± {:.2}) of the motion's predicted ones",
+        support.cues, support.share, support.standard_error
+    );
+    if support.confirms(min_support) {
+        log.push(format!("stage 2 check: {shown}, clearly over {min_support}: kept"));
+        return true;
+    }
+    fitted.parameters.iter_mut().for_each(|p| *p = 0.0);
+    let verdict = if support.refutes(min_support) { "clearly under" } else { "not clearly over" };
+    log.push(format!("stage 2 check: {shown}, {verdict} {min_support}: taken for a drift of the fit, no motion kept"));
+    false
+}
