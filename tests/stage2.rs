@@ -171,24 +171,33 @@ fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
     generate_turning(still.path(), 0.0);
     let none = MotionRecord::zero();
     let lines = |stdout: &str, start: &str| stdout.lines().filter(|l| l.starts_with(start)).map(str::to_string).collect::<Vec<_>>();
-    // Trains `name` on the scene in `root` with the cue term and the check at `min_support`;
-    // returns the log, the result folder and its motion.
-    let run = |root: &Path, name: &str, min_support: f64| {
-        let extra = format!("iterations = 10\ncue_weight = 1.0\nmin_cue_support = {min_support:?}");
+    // Trains `name` on the scene in `root` with the cue term, the check at `min_support` and
+    // `more` settings of stage 2; returns the log, the result folder and its motion.
+    let run = |root: &Path, name: &str, min_support: f64, more: &str| {
+        let extra = format!("iterations = 10\ncue_weight = 1.0\nmin_cue_support = {min_support:?}\n{more}");
         let stdout = train(root, &config(root, name, "constant_velocity", &extra), name);
         (stdout, root.join(name), motion_of(root, name))
     };
+    let refit_check = "stage 2 check of the fit with the measured cues: ";
     for (root, kept) in [(turning.path(), true), (still.path(), false)] {
-        let (stdout, out, motion) = run(root, "checked", 0.5);
+        let (stdout, out, motion) = run(root, "checked", 0.5, "");
         // The fit the check judges leaves the measured cues out.
         let first = lines(&stdout, "stage 2 fit: ");
         assert!(first.len() == 1 && !first[0].contains("measured-cue term"), "{stdout}");
         let check = lines(&stdout, "stage 2 check: ");
         eprintln!("{}", check.join("\n"));
-        assert!(check.len() == 1 && check[0].ends_with(if kept { "clearly over 0.5: kept" } else { "no motion kept" }), "{stdout}");
+        let verdict = if kept { "clearly over 0.5: kept" } else { "unless the fit with the measured cues stands clear of their scatter" };
+        assert!(check.len() == 1 && check[0].ends_with(verdict), "{stdout}");
+        // Either way the motion is fitted again with the cues, from the start.
         let second = lines(&stdout, "stage 2 fit with the measured cues: ");
+        assert!(second.len() == 1 && second[0].contains("measured-cue term ×1 over"), "{stdout}");
+        let curve = std::fs::read_to_string(out.join("loss_stage2_cues.csv")).unwrap();
+        assert_eq!(curve.lines().count(), 11, "{curve}");
+        let judged = lines(&stdout, refit_check);
+        eprintln!("{}", judged.join("\n"));
         if kept {
-            assert!(second.len() == 1 && second[0].contains("measured-cue term ×1 over"), "{stdout}");
+            // A confirmed motion's fit with the cues is kept with no second judgement.
+            assert!(judged.is_empty(), "{stdout}");
             // The line ends with the motion the fit kept, as motion.toml names it.
             let number = |x: f64| if x == 0.0 { "0".to_string() } else { format!("{x:.4e}") };
             let groups: Vec<String> = motion
@@ -197,23 +206,39 @@ fn the_cue_check_judges_the_photometric_fit_and_the_cue_term_joins_after_it() {
                 .map(|(name, values)| format!("{name} [{}]", values.into_iter().map(number).collect::<Vec<_>>().join(", ")))
                 .collect();
             assert!(second[0].ends_with(&format!("; estimate {}", groups.join(", "))), "{}", second[0]);
-            let curve = std::fs::read_to_string(out.join("loss_stage2_cues.csv")).unwrap();
-            assert_eq!(curve.lines().count(), 11, "{curve}");
             assert!(motion != none, "{motion:?}");
         } else {
-            assert!(second.is_empty() && !out.join("loss_stage2_cues.csv").exists(), "{stdout}");
+            // The still scene's fit with the cues does not stand clear of their scatter.
+            assert!(judged.len() == 1 && judged[0].ends_with("no motion kept"), "{stdout}");
             assert!(motion == none, "{motion:?}");
         }
     }
-    // Neither refuted nor confirmed: not shown by the cues, so set to none, and the term does
-    // not run.
-    let (stdout, _, motion) = run(turning.path(), "undecided", 0.75);
+    // Neither refuted nor confirmed, and no second fit asked for (`min_cue_signal = 0`): not
+    // shown by the cues, so set to none, and the term does not run.
+    let (stdout, _, motion) = run(turning.path(), "undecided", 0.75, "min_cue_signal = 0.0");
     let check = lines(&stdout, "stage 2 check: ");
     assert!(check.len() == 1 && check[0].ends_with("not clearly over 0.75: taken for a drift of the fit, no motion kept"), "{stdout}");
     assert!(lines(&stdout, "stage 2 fit with the measured cues").is_empty(), "{stdout}");
     assert_eq!(motion, none);
+    // The second fit's motion is judged on its own: measured, its cues bear out 1.12 (± 0.07)
+    // of it, and the cues it predicts stand 0.76 times their scatter clear of none, per cue:
+    // over the default 0.6 (the suites' moving scenes 1.0-11.5, their still ones 0.08-0.33) and
+    // under 1. The turn it keeps is the truth's (1 rad/s about y) to within half of its
+    // image-space effect (`rslf train` reports it).
+    for (signal, kept) in [("min_cue_signal = 1.0", false), ("", true)] {
+        let (stdout, _, motion) = run(turning.path(), "refitted", 0.75, signal);
+        let judged = lines(&stdout, refit_check);
+        eprintln!("{}", judged.join("\n"));
+        assert!(judged.len() == 1 && judged[0].ends_with(if kept { ": kept" } else { "no motion kept" }), "{stdout}");
+        assert_eq!(motion == none, !kept, "{motion:?}");
+        let report = lines(&stdout, "motion     image-space RMS error ").pop().unwrap_or_default();
+        let px = |after: &str| report.split(after).nth(1)?.split_whitespace().next()?.parse::<f64>().ok();
+        let (Some(error), Some(shift)) = (px("RMS error "), px("true RS shift ")) else { panic!("no motion error in {stdout}") };
+        eprintln!("{error} px off a {shift} px shift");
+        assert!(if kept { error < 0.5 * shift } else { error == shift }, "{report}");
+    }
     // With no check, the one fit has the term from its first step.
-    let (stdout, _, _) = run(turning.path(), "unchecked", 0.0);
+    let (stdout, _, _) = run(turning.path(), "unchecked", 0.0, "");
     let fits = lines(&stdout, "stage 2 fit");
     assert!(fits.len() == 1 && fits[0].contains("measured-cue term ×1 over"), "{stdout}");
     assert!(!stdout.contains("stage 2 check"), "{stdout}");

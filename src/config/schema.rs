@@ -203,8 +203,17 @@ pub struct Stage2Config {
     /// motion for it to be kept: the noise-weighted least-squares scale of the estimate's
     /// predicted cues that fits the measured ones (1: borne out, 0: no such motion seen). Unless
     /// it is over it by two standard errors, the estimate is taken for a drift of the photometric
-    /// fit and no motion is kept. 0 = no check.
+    /// fit and no motion is kept, unless the fit with the cues (`min_cue_signal`) is. 0 = no
+    /// check.
     pub min_cue_support: f64,
+    /// A motion whose photometric fit the check does not confirm is fitted again from the start
+    /// with the measured cues (`cue_weight`), and kept when the cues confirm that fit at
+    /// `min_cue_support` and its predicted cues stand at least this many times the measured
+    /// cues' scatter clear of none, per cue ([`crate::pipeline::CueSupport::signal`]): the
+    /// photometric fit can overshoot a true motion past the check, while a still scene's fit
+    /// with the cues keeps only what their biases bear out. 0 = no such fit (the motion is set
+    /// to none).
+    pub min_cue_signal: f64,
     /// The views the cues are measured in: `corners` or `all_off_row` (every present view off
     /// the central row and the central column, each tracked from the central-row view of its
     /// column).
@@ -260,6 +269,7 @@ impl Default for Stage2Config {
             aperture_weighting: false,
             cue_weight: 1.0,
             min_cue_support: 0.5,
+            min_cue_signal: 0.6,
             cue_views: ViewSelection::Corners,
             cue_edges: false,
             cue_outlier_bound: 2.0,

@@ -43,6 +43,16 @@ impl CueSupport {
     pub fn confirms(&self, min_share: f64) -> bool {
         self.share - 2.0 * self.standard_error >= min_share
     }
+
+    /// How far the cues the motion predicts stand clear of none, per cue, in units of the
+    /// measured cues' scatter: the support's share over its standard error (the signal-to-noise
+    /// ratio of the motion in all the cues) over the square root of their number. About the RMS
+    /// of the predicted cues over the scatter for a motion the cues bear out; unlike the ratio
+    /// itself it does not grow with the number of cues, which would carry the cues' shared
+    /// biases (not counted in the scatter) over any fixed bound on a large enough image.
+    pub fn signal(&self) -> f64 {
+        self.share / (self.standard_error * (self.cues.max(1) as f64).sqrt())
+    }
 }
 
 /// The support `cues` give `estimate` on a scene seen by `camera`: each measured component of
