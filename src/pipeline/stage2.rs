@@ -7,7 +7,7 @@ use super::{
     Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Fit, TrackedCues, column_views, cue_support, drop_outlying_matches,
     fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
 };
-use crate::config::{Config, ViewSelection};
+use crate::config::{Config, Stage2Config, ViewSelection};
 use crate::geometry::{Camera, ViewId};
 use crate::io::{Raster, Scene};
 use crate::loss::WeightedLosses;
@@ -221,24 +221,23 @@ pub(super) fn run(
     // support 0.42): the motion fitted with the cues is kept where the cues it predicts stand
     // clear of their scatter. A still scene's do not: its drift shrinks to what the cues'
     // biases bear out (docs/results.md).
-    keep_refit(refit, fitted, model, camera, &two_way, s.min_cue_support, s.min_cue_signal, log)
+    keep_refit(refit, fitted, model, camera, &two_way, s, log)
 }
 
 /// The motion fitted with the measured cues after the check did not confirm the photometric
-/// one (`still`, set to none): kept when the cues confirm it at `min_support` and its predicted
-/// cues stand at least `min_signal` times the cues' scatter clear of none, per cue
+/// one (`still`, set to none): kept when the cues confirm it at `min_cue_support` and its
+/// predicted cues stand at least `min_cue_signal` times the cues' scatter clear of none, per cue
 /// ([`super::CueSupport::signal`]), else `still`.
-#[allow(clippy::too_many_arguments)]
 fn keep_refit(
     refit: MotionFit,
     still: MotionFit,
     model: &dyn MotionModel,
     camera: &Camera,
     cues: &[Cue],
-    min_support: f64,
-    min_signal: f64,
+    settings: &Stage2Config,
     log: &mut RunLog,
 ) -> MotionFit {
+    let (min_support, min_signal) = (settings.min_cue_support, settings.min_cue_signal);
     let support = cue_support(camera, &model.record(&refit.parameters), cues);
     let shown = support.map_or("no judgement (too few cues imaged, or no motion)".to_string(), |c| {
         format!(
