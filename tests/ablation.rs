@@ -1,5 +1,6 @@
 //! `rslf ablation` end to end on the smallest suite: one base scene, static plus one slow and one
-//! fast direction, at 32x32 px with a few steps per stage.
+//! fast direction, at 64x64 px (at 32 px too few cues are imaged for the cue check to judge) with
+//! a few steps per stage.
 
 mod common;
 
@@ -13,13 +14,18 @@ fn the_ablation_prints_and_writes_the_four_row_table() {
         .unwrap();
     let out = root.path().join("ablation");
     let (ok, stdout, stderr) = rslf_with_env(
-        &["ablation", config.to_str().unwrap(), "--size", "32", "--bases", "objects", "--directions", "1", "--out", out.to_str().unwrap()],
+        &["ablation", config.to_str().unwrap(), "--size", "64", "--bases", "objects", "--directions", "1", "--out", out.to_str().unwrap()],
         &[("RSLF_CACHE_DIR", &root.path().join("cache"))],
     );
     assert!(ok, "{stderr}");
-    assert!(stdout.contains("ablation: 3 scenes x 4 variants at 32x32 px"), "{stdout}");
+    assert!(stdout.contains("ablation: 3 scenes x 4 variants at 64x64 px"), "{stdout}");
     // The cue check's verdict under each run that fits a motion (3 scenes x 2 variants).
     assert_eq!(stdout.matches(" check: ").count(), 6, "{stdout}");
+    // And the verdict on the fit with the cues under each check that leaves the motion to it
+    // (four at this size: both fitting variants of the still and the slow scene).
+    let second_chances = stdout.lines().filter(|l| l.contains(" check: ") && l.ends_with("stands clear of their scatter")).count();
+    assert!(second_chances > 0, "{stdout}");
+    assert_eq!(stdout.matches(" second fit: ").count(), second_chances, "{stdout}");
     let table = std::fs::read_to_string(out.join("ablation.md")).unwrap();
     assert!(stdout.contains(&table), "the printed table is the written one");
     let rows: Vec<&str> = table.lines().skip(2).take(4).collect();

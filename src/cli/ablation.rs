@@ -106,10 +106,13 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
                 motion_error_px.map_or(String::new(), |e| format!("  motion {e:.2} px")),
                 seconds
             );
-            // The cue check's verdict where stage 2 ran: a drift it kept on a still scene shows
-            // here by name, not only as a motion error.
-            if let Some(check) = log.lines.iter().find_map(|l| l.strip_prefix("stage 2 check: ")) {
-                outln!("  {:24} {:20} check: {check}", "", "");
+            // The cue check's verdict where stage 2 ran, and that of the fit with the cues that
+            // may follow a motion it does not confirm: a drift kept on a still scene shows here
+            // by name, not only as a motion error.
+            for (prefix, label) in [("stage 2 check: ", "check"), ("stage 2 check of the fit with the measured cues: ", "second fit")] {
+                if let Some(verdict) = log.lines.iter().find_map(|l| l.strip_prefix(prefix)) {
+                    outln!("  {:24} {:20} {label}: {verdict}", "", "");
+                }
             }
             rows.push(Row {
                 scene: entry.name.clone(),
