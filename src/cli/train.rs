@@ -20,7 +20,7 @@ pub struct TrainArgs {
     /// Device; overrides the config's `device`.
     #[arg(long, value_enum)]
     pub device: Option<DeviceChoice>,
-    /// Folder of saved models; the fitted model goes to MODELS/<result folder name>/model.json.
+    /// Folder of saved models; the fitted model goes to `MODELS/<result folder name>/model.json`.
     #[arg(long, default_value = "models")]
     pub models: PathBuf,
 }
