@@ -109,7 +109,7 @@ pub fn run(args: AblationArgs) -> crate::Result<()> {
             // The cue check's verdict where stage 2 ran, and that of the fit with the cues that
             // may follow a motion it does not confirm: a drift kept on a still scene shows here
             // by name, not only as a motion error.
-            for (prefix, label) in [("stage 2 check: ", "check"), ("stage 2 check of the fit with the measured cues: ", "second fit")] {
+            for (prefix, label) in [(pipeline::CHECK_LINE, "check"), (pipeline::REFIT_CHECK_LINE, "second fit")] {
                 if let Some(verdict) = log.lines.iter().find_map(|l| l.strip_prefix(prefix)) {
                     outln!("  {:24} {:20} {label}: {verdict}", "", "");
                 }

@@ -32,6 +32,13 @@ const NEWTON_MAX_STEP: f64 = 2.0;
 /// directions (1/80 and more) carried the gains (docs/results.md).
 const NEWTON_MIN_CURVATURE_RATIO: f64 = 5e-3;
 
+/// How the run log's line with stage 2's cue check's verdict begins; readers of a log, such as
+/// `rslf ablation`, find the verdict by it.
+pub const CHECK_LINE: &str = "stage 2 check: ";
+/// How the line with the verdict on the fit with the cues, after a check that did not confirm
+/// the motion, begins.
+pub const REFIT_CHECK_LINE: &str = "stage 2 check of the fit with the measured cues: ";
+
 /// Stage 2: the motion, fitted against the off-row views and checked against the cues measured
 /// between them. With the check on, the measured-cue term (`cue_weight`) joins only after it:
 /// the photometric fit alone is judged (a fit to the cues would pass any check against them). A
@@ -249,7 +256,7 @@ fn keep_refit(
     });
     let kept = support.is_some_and(|c| c.confirms(min_support) && c.signal() >= min_signal);
     log.push(format!(
-        "stage 2 check of the fit with the measured cues: they bear out {shown}; {}",
+        "{REFIT_CHECK_LINE}they bear out {shown}; {}",
         if kept {
             format!("clearly over {min_support}, and at least {min_signal} times: kept")
         } else {
@@ -275,7 +282,7 @@ pub(super) fn check_motion(
     log: &mut RunLog,
 ) -> Option<bool> {
     let Some(support) = cue_support(camera, &model.record(&fitted.parameters), cues) else {
-        log.push(format!("stage 2 check: not made ({} measured cues; at least 100 imaged and a motion are needed)", cues.len()));
+        log.push(format!("{CHECK_LINE}not made ({} measured cues; at least 100 imaged and a motion are needed)", cues.len()));
         return None;
     };
     let shown = format!(
@@ -283,12 +290,12 @@ pub(super) fn check_motion(
         support.cues, support.share, support.standard_error
     );
     if support.confirms(min_support) {
-        log.push(format!("stage 2 check: {shown}, clearly over {min_support}: kept"));
+        log.push(format!("{CHECK_LINE}{shown}, clearly over {min_support}: kept"));
         return Some(true);
     }
     fitted.parameters.iter_mut().for_each(|p| *p = 0.0);
     let verdict = if support.refutes(min_support) { "clearly under" } else { "not clearly over" };
     let then = if second_chance { "unless the fit with the measured cues stands clear of their scatter" } else { "no motion kept" };
-    log.push(format!("stage 2 check: {shown}, {verdict} {min_support}: taken for a drift of the fit, {then}"));
+    log.push(format!("{CHECK_LINE}{shown}, {verdict} {min_support}: taken for a drift of the fit, {then}"));
     Some(false)
 }
