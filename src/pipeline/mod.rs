@@ -38,7 +38,7 @@ pub use run_log::RunLog;
 pub use spline_image::SplineImage;
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
 pub use stage2::{CHECK_LINE, REFIT_CHECK_LINE};
-pub use stage2_fit::{MotionFit, Stage2Fit, fit_stage2, motion_scales, pose_table};
+pub use stage2_fit::{MotionFit, Stage2Context, Stage2Fit, fit_stage2, motion_scales, pose_table};
 pub use view_tracking::{Track, TrackSettings, textured_points, track};
 pub use visibility::explained_mask;
 
@@ -184,25 +184,21 @@ pub fn static_shape(g: &Gaussians, camera: &Camera, model: &dyn MotionModel, par
     StaticShape::new(g, TensorCamera::new(camera), model, params_tensor(params, device))
 }
 
-/// Renders the central view at t = 0 of the static shape of `g` under `model` at `params`:
-/// the rolling-shutter-compensated colour and disparity.
-#[allow(clippy::too_many_arguments)]
+/// Renders the central view at t = 0 of `shape`, the static shape under `model` at `params`
+/// ([`static_shape`]): the rolling-shutter-compensated colour, and the disparity where opaque
+/// enough (elsewhere `fallback`'s).
 pub fn render_compensated_central(
-    g: &Gaussians,
-    scene: &Scene,
-    camera: &Camera,
+    shape: &StaticShape,
     model: &dyn MotionModel,
     params: &[f64],
+    scene: &Scene,
     settings: &RenderSettings,
     fallback: &Raster,
     device: &Device,
-) -> (Raster, Raster, StaticShape) {
+) -> (Raster, Raster) {
     let (w, h, c) = (scene.width(), scene.height(), scene.channels());
-    let shape = static_shape(g, camera, model, params, device);
     let splats = shape.splats_at_time(model, params_tensor(params, device), (0.0, 0.0), 0.0);
-    let out = splat(&splats, &splats.bins(w, 0..h, settings), device);
-    let (colour, disparity) = central_rasters(out, w, h, c, fallback);
-    (colour, disparity, shape)
+    central_rasters(splat(&splats, &splats.bins(w, 0..h, settings), device), w, h, c, fallback)
 }
 
 /// Runs the pipeline on `scene` with `config` on `device`, with the built-in loss terms and
@@ -271,23 +267,19 @@ pub fn run_logged(
             }
             // The stage-1 geometry the disocclusion masks come from, rendered only when they are asked for.
             let stage1_disparity = config.stage2.mask_disocclusions.then(|| render_central(&gaussians, scene, &render, &initial, device).1);
-            let fitted = stage2::run(
-                config,
+            let ctx = Stage2Context {
                 scene,
-                cam,
-                model.as_ref(),
-                gaussians.clone(),
-                &start,
-                &stage2_losses,
+                camera: cam,
+                model: model.as_ref(),
+                losses: &stage2_losses,
                 device,
-                stage1_disparity.as_ref(),
-                &initial,
-                &mut log,
-                &mut curves,
-            );
+                central_disparity: stage1_disparity.as_ref(),
+            };
+            let fitted = stage2::run(config, &ctx, gaussians.clone(), &start, &initial, &mut log, &mut curves);
             let gaussians = fitted.gaussians.clone();
-            let (central, disparity, shape) =
-                render_compensated_central(&gaussians, scene, cam, model.as_ref(), &fitted.parameters, &render, &initial, device);
+            let shape = static_shape(&gaussians, cam, model.as_ref(), &fitted.parameters, device);
+            let (central, disparity) =
+                render_compensated_central(&shape, model.as_ref(), &fitted.parameters, scene, &render, &initial, device);
             (central, disparity, Some(model.record(&fitted.parameters)), Some(PointCloud::of_shape(&shape)), gaussians)
         }
         _ => {

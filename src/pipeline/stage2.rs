@@ -4,18 +4,16 @@
 
 use super::run_log::{RunLog, curve_ends, estimate_line};
 use super::{
-    Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Fit, TrackedCues, column_views, cue_support, drop_outlying_matches,
-    fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
+    Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Context, Stage2Fit, TrackedCues, column_views, cue_support,
+    drop_outlying_matches, fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
 };
 use crate::config::{Config, Stage2Config, ViewSelection};
 use crate::geometry::{Camera, ViewId};
-use crate::io::{Raster, Scene};
-use crate::loss::WeightedLosses;
+use crate::io::Raster;
 use crate::model::Gaussians;
 use crate::model::motion::MotionModel;
 use crate::optim::NewtonSettings;
 use crate::render::row_bands;
-use burn::tensor::Device;
 use std::time::Instant;
 
 /// Residual (px) beyond which a measured cue counts linearly in the cue term.
@@ -47,21 +45,17 @@ pub const REFIT_CHECK_LINE: &str = "stage 2 check of the fit with the measured c
 /// with the term, run too when `min_cue_signal` is over 0, stands clear of the cues' scatter
 /// ([`keep_refit`]). The loss curves go to `curves`: `stage2`, then `stage2_cues` when the
 /// second fit runs.
-#[allow(clippy::too_many_arguments)]
+/// The cues are tracked with `initial_disparity`, the stage-1 initialisation's.
 pub(super) fn run(
     config: &Config,
-    scene: &Scene,
-    camera: &Camera,
-    model: &dyn MotionModel,
+    ctx: &Stage2Context,
     gaussians: Gaussians,
     start_values: &[f64],
-    losses: &WeightedLosses,
-    device: &Device,
-    stage1_disparity: Option<&Raster>,
     initial_disparity: &Raster,
     log: &mut RunLog,
     curves: &mut LossCurves,
 ) -> MotionFit {
+    let Stage2Context { scene, camera, model, losses, device, .. } = *ctx;
     let s = &config.stage2;
     // The cue check judges a fitted motion; a motion given with no iterations is used as it is.
     let check = s.min_cue_support > 0.0 && s.iterations > 0;
@@ -145,26 +139,13 @@ pub(super) fn run(
         let bar = crate::progress::bar(s.iterations as u64, &format!("stage 2: {what}"));
         let start = Instant::now();
         let fit = if last { fit.clone() } else { Stage2Fit { newton: NewtonSettings { iterations: 0, ..fit.newton }, ..fit.clone() } };
-        let fitted = fit_stage2(
-            g,
-            scene,
-            camera,
-            &views,
-            model,
-            start_values,
-            &fit,
-            losses,
-            device,
-            stage1_disparity,
-            cue_term,
-            |done, of, loss| {
-                bar.set_position(done.min(of) as u64);
-                bar.set_message(match done.checked_sub(of).filter(|&k| k > 0) {
-                    None => format!("stage 2 ({what}): loss {loss:.4}"),
-                    Some(k) => format!("stage 2 ({what}): Newton steps, objective {loss:.5} ({k} evaluations)"),
-                });
-            },
-        );
+        let fitted = fit_stage2(g, ctx, &views, start_values, &fit, cue_term, |done, of, loss| {
+            bar.set_position(done.min(of) as u64);
+            bar.set_message(match done.checked_sub(of).filter(|&k| k > 0) {
+                None => format!("stage 2 ({what}): loss {loss:.4}"),
+                Some(k) => format!("stage 2 ({what}): Newton steps, objective {loss:.5} ({k} evaluations)"),
+            });
+        });
         bar.finish_and_clear();
         // Each step scores `bands_per_step` bands drawn across the image.
         let bands = row_bands(0..scene.height(), s.band_height).len();

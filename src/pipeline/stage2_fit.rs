@@ -145,27 +145,42 @@ pub fn pose_table<'a>(model: &'a dyn MotionModel, camera: &Camera) -> Tabulated<
     Tabulated::with_step(model, span, camera.line_time_s / TABLE_SAMPLES_PER_ROW)
 }
 
-/// Fits `model`'s parameters, starting from `start` (SI), to `views` of `scene`; the Gaussians
-/// `g` are held fixed unless `fit.refine` is set. With `fit.disocclusion_margin` set, the
-/// disocclusion masks are derived from `central_disparity` (the central view's disparity, e.g.
-/// the stage-1 render) and the current motion estimate; without a map no pixel is masked.
-/// `progress(step, total, loss)` is called after each Adam step, and after each evaluation of
-/// the Newton steps (with `step` past `total`).
-#[allow(clippy::too_many_arguments)]
+/// What a stage-2 fit is posed on: the scene and its camera, the motion model, the loss terms
+/// that score a rendering, the device the fit runs on, and the central view's disparity (e.g.
+/// the stage-1 render) that disocclusion masks are drawn from, if any.
+#[derive(Clone, Copy)]
+pub struct Stage2Context<'a> {
+    /// The capture the views are compared against.
+    pub scene: &'a Scene,
+    /// Its camera (from `parameters.cfg`).
+    pub camera: &'a Camera,
+    /// The motion model whose parameters are fitted.
+    pub model: &'a dyn MotionModel,
+    /// The loss terms, with their weights.
+    pub losses: &'a WeightedLosses,
+    /// The device the fit runs on.
+    pub device: &'a Device,
+    /// The central view's disparity map; without one no pixel is masked, whatever
+    /// [`Stage2Fit::disocclusion_margin`] says.
+    pub central_disparity: Option<&'a Raster>,
+}
+
+/// Fits `ctx.model`'s parameters, starting from `start` (SI), to `views` of `ctx.scene`; the
+/// Gaussians `g` are held fixed unless `fit.refine` is set. With `fit.disocclusion_margin` set,
+/// the disocclusion masks are derived from `ctx.central_disparity` and the current motion
+/// estimate. `cues`, when given, joins the objective. `progress(step, total, loss)` is called
+/// after each Adam step, and after each evaluation of the Newton steps (with `step` past
+/// `total`).
 pub fn fit_stage2(
     g: Gaussians,
-    scene: &Scene,
-    camera: &Camera,
+    ctx: &Stage2Context,
     views: &[ViewId],
-    model: &dyn MotionModel,
     start: &[f64],
     fit: &Stage2Fit,
-    losses: &WeightedLosses,
-    device: &Device,
-    central_disparity: Option<&Raster>,
     cues: Option<&CueTerm>,
     mut progress: impl FnMut(usize, usize, f32),
 ) -> MotionFit {
+    let Stage2Context { scene, camera, model, losses, device, central_disparity } = *ctx;
     let g = if fit.refine.is_some() { g } else { g.no_grad() };
     let table = pose_table(model, camera);
     let model: &dyn MotionModel = &table;
