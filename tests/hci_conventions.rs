@@ -159,12 +159,16 @@ fn the_disocclusion_mask_of_antinous_corners_leaves_out_what_the_central_view_do
 
 #[test]
 fn stage_2_takes_cottons_corners_and_without_them_the_outermost_views_of_each_quadrant() {
-    use rslf::config::ViewSelection::{AllOffRow, Corners};
+    use rslf::config::ViewSelection::{AllOffRow, Corners, Diagonals};
     use rslf::pipeline::stage2_views;
     let source = hci("cotton");
     let scene = Scene::load(&source).unwrap();
     assert_eq!(stage2_views(&scene, Corners), scene.grid.corners().to_vec());
     assert_eq!(stage2_views(&scene, AllOffRow).len(), 24, "33 views less the 9 of the central row");
+    // HCI's 33 views hold, off the central row and column, the two diagonals and nothing else.
+    let off_column: Vec<ViewId> = stage2_views(&scene, AllOffRow).into_iter().filter(|v| v.col != 4).collect();
+    assert_eq!(stage2_views(&scene, Diagonals), off_column);
+    assert_eq!(off_column.len(), 16);
     // Cotton copied without some of its views: `keep(row, col)` says which stay.
     let without = |keep: &dyn Fn(usize, usize) -> bool| {
         let dir = common::tempdir();
@@ -187,5 +191,7 @@ fn stage_2_takes_cottons_corners_and_without_them_the_outermost_views_of_each_qu
     assert_eq!(stage2_views(&cornerless, Corners), vec![v(1, 1), v(1, 7), v(7, 1), v(7, 7)]);
     // The central row and column alone: no view in any quadrant, so the column's eight are taken.
     let (_dir, cross) = without(&|r, c| r == 4 || c == 4);
-    assert_eq!(stage2_views(&cross, Corners), (0..9).filter(|&r| r != 4).map(|r| v(r, 4)).collect::<Vec<_>>());
+    let column = (0..9).filter(|&r| r != 4).map(|r| v(r, 4)).collect::<Vec<_>>();
+    assert_eq!(stage2_views(&cross, Corners), column);
+    assert_eq!(stage2_views(&cross, Diagonals), column);
 }

@@ -138,6 +138,9 @@ pub enum ViewSelection {
     Corners,
     /// Every present view off the central row.
     AllOffRow,
+    /// The present views on the grid's two diagonals, off the central row: 16 of a 9 x 9 grid,
+    /// and all that the HCI benchmark's 33-view captures hold off the central row and column.
+    Diagonals,
 }
 
 /// How stage 2 assigns read-out times when it renders a rolling-shutter view.
@@ -214,9 +217,9 @@ pub struct Stage2Config {
     /// with the cues keeps only what their biases bear out. 0 = no such fit (the motion is set
     /// to none).
     pub min_cue_signal: f64,
-    /// The views the cues are measured in: `corners` or `all_off_row` (every present view off
-    /// the central row and the central column, each tracked from the central-row view of its
-    /// column).
+    /// The views the cues are measured in: `corners`, `diagonals` or `all_off_row` (every
+    /// present view off the central row and the central column), each tracked from the
+    /// central-row view of its column.
     pub cue_views: ViewSelection,
     /// Edges and stripes (patches textured one way) give cues to the fit too: the component of
     /// the cue across them. They reach rows that patches textured both ways leave without cues

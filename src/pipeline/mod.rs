@@ -115,33 +115,35 @@ impl Registries {
     }
 }
 
-/// The views stage 2 compares against: the four corners or every present view off the
-/// central row.
+/// The views stage 2 compares against: the four corners, the diagonals, or every present view
+/// off the central row.
 ///
 /// `Corners` takes, in each quadrant of the grid (off the central row and column), the present
 /// view farthest from the central row, and of those the one farthest from the central column:
 /// the corner itself when it is there (the paper's choice). A capture that lacks the corners
 /// (a plenoptic camera's vignetted corner views are often dropped) gets the outermost views it
 /// has; the vertical offset comes first because it alone sets the read-out delay the motion
-/// shows in. With no view in any quadrant (only the central row and column), every view off
-/// the central row is taken.
+/// shows in. `Diagonals` takes the present views as far from the central row as from the
+/// central column. With none of the views either asks for (only the central row and column),
+/// every view off the central row is taken.
 pub fn stage2_views(scene: &Scene, selection: ViewSelection) -> Vec<ViewId> {
     let centre = scene.central_id();
     let off_row: Vec<ViewId> = scene.present_views().into_iter().filter(|v| v.row != centre.row).collect();
-    if selection == ViewSelection::AllOffRow {
-        return off_row;
-    }
-    let corners: Vec<ViewId> = [(false, false), (false, true), (true, false), (true, true)]
-        .into_iter()
-        .filter_map(|(below, right)| {
-            off_row
-                .iter()
-                .filter(|v| v.col != centre.col && (v.row > centre.row) == below && (v.col > centre.col) == right)
-                .max_by_key(|v| (v.row.abs_diff(centre.row), v.col.abs_diff(centre.col)))
-                .copied()
-        })
-        .collect();
-    if corners.is_empty() { off_row } else { corners }
+    let chosen: Vec<ViewId> = match selection {
+        ViewSelection::AllOffRow => return off_row,
+        ViewSelection::Diagonals => off_row.iter().copied().filter(|v| v.row.abs_diff(centre.row) == v.col.abs_diff(centre.col)).collect(),
+        ViewSelection::Corners => [(false, false), (false, true), (true, false), (true, true)]
+            .into_iter()
+            .filter_map(|(below, right)| {
+                off_row
+                    .iter()
+                    .filter(|v| v.col != centre.col && (v.row > centre.row) == below && (v.col > centre.col) == right)
+                    .max_by_key(|v| (v.row.abs_diff(centre.row), v.col.abs_diff(centre.col)))
+                    .copied()
+            })
+            .collect(),
+    };
+    if chosen.is_empty() { off_row } else { chosen }
 }
 
 /// The read-out timing a config asks for.
