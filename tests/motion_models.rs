@@ -9,7 +9,7 @@ use rslf::geometry::{Camera, Pose, TensorCamera, ViewGrid, pose_at};
 use rslf::io::MotionRecord;
 use rslf::model::GaussianSet;
 use rslf::model::motion::{MotionModel, MotionRegistry, MotionSetup, Tabulated};
-use rslf::render::{RenderSettings, RsTiming, StaticShape, render_rolling_shutter};
+use rslf::render::{RenderSettings, RsTiming, StaticShape, ViewWindow, render_rolling_shutter};
 
 const READOUT: (f64, f64) = (-0.02, 0.02);
 
@@ -189,7 +189,8 @@ fn objective(m: &dyn MotionModel, params: &[f64], timing: RsTiming, device: &Dev
     // Every Gaussian in every bin and a footprint out to 6σ: the bins, recomputed in each
     // evaluation, then cannot change the value (a 3σ cut-off would add jumps of e^-4.5).
     let settings = RenderSettings { max_per_pixel: 32, cutoff_sigma: 6.0 };
-    let out = render_rolling_shutter(&shape, m, p.clone(), (4.0, 4.0), cam.width, 0..cam.height, timing, &settings, device);
+    let window = ViewWindow { offset: (4.0, 4.0), width: cam.width, rows: 0..cam.height };
+    let out = render_rolling_shutter(&shape, m, p.clone(), window, timing, &settings, device);
     let n = out.colour.dims()[0];
     let pattern = Tensor::<1>::from_data(TensorData::new((0..n).map(|i| ((i * 37 % 11) as f32) / 11.0).collect::<Vec<_>>(), [n]), device);
     let value = (out.colour.reshape([n]) * pattern.clone()).mean() + (out.disparity * pattern).mean() * 0.1;
@@ -230,7 +231,8 @@ fn without_motion_the_rolling_shutter_render_is_the_static_light_field_render() 
     let shape = StaticShape::new(&g, TensorCamera::new(&cam), m.as_ref(), zero.clone());
     let settings = RenderSettings { max_per_pixel: 8, cutoff_sigma: 3.0 };
     let offset = (-4.0f32, 4.0f32);
-    let rs = render_rolling_shutter(&shape, m.as_ref(), zero, offset, cam.width, 0..cam.height, RsTiming::Bands(5), &settings, &device);
+    let window = ViewWindow { offset, width: cam.width, rows: 0..cam.height };
+    let rs = render_rolling_shutter(&shape, m.as_ref(), zero, window, RsTiming::Bands(5), &settings, &device);
     let plain = rslf::render::render_rows(&g, offset, cam.width, 0..cam.height, &settings, &device);
     let (a, b) = (host(rs.colour), host(plain.colour));
     let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs()).fold(0.0f32, f32::max);

@@ -7,7 +7,7 @@ use crate::geometry::{ViewGrid, ViewId, readout_interval};
 use crate::io::{MotionRecord, Raster};
 use crate::model::SavedModel;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
-use crate::render::{RenderSettings, RsTiming, render_rolling_shutter, render_rows};
+use crate::render::{RenderSettings, RsTiming, ViewWindow, render_rolling_shutter, render_rows};
 use burn::tensor::Device;
 
 /// Fixed-point iterations of the per-Gaussian read-out time when rendering as captured.
@@ -79,7 +79,8 @@ pub fn render_light_field(
                     }
                     Moment::Capture => {
                         let timing = RsTiming::PerGaussian(CAPTURE_TIMING_ITERATIONS);
-                        render_rolling_shutter(shape, model.as_ref(), p, offset, w, 0..h, timing, settings, device)
+                        let window = ViewWindow { offset, width: w, rows: 0..h };
+                        render_rolling_shutter(shape, model.as_ref(), p, window, timing, settings, device)
                     }
                 }
             }

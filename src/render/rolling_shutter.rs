@@ -104,20 +104,30 @@ pub fn bands(rows: Range<usize>, timing: RsTiming, camera: &TensorCamera) -> Vec
     }
 }
 
-/// Renders `rows` of the rolling-shutter view at `offset` (`width` pixels wide): band by band or
-/// in one pass, as `timing` says. Outputs are row-major over `rows`.
-#[allow(clippy::too_many_arguments)]
+/// The part of a view to render: the view's offset `(c - cc, r - rc)` from the central view, its
+/// width in pixels, and the rows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewWindow {
+    /// `(c - cc, r - rc)`, in views.
+    pub offset: (f32, f32),
+    /// Pixels per row.
+    pub width: usize,
+    /// The rows rendered, top to bottom.
+    pub rows: Range<usize>,
+}
+
+/// Renders `window` of the rolling-shutter view of `shape` moved by `model` at `params` (SI):
+/// band by band or in one pass, as `timing` says. Outputs are row-major over the window's rows.
 pub fn render_rolling_shutter(
     shape: &StaticShape,
     model: &dyn MotionModel,
     params: Tensor<1>,
-    offset: (f32, f32),
-    width: usize,
-    rows: Range<usize>,
+    window: ViewWindow,
     timing: RsTiming,
     settings: &RenderSettings,
     device: &Device,
 ) -> RenderOutput {
+    let ViewWindow { offset, width, rows } = window;
     let parts: Vec<RenderOutput> = match timing {
         RsTiming::PerGaussian(iterations) => {
             let s = shape.splats_rolling(model, params, offset, iterations);
