@@ -147,6 +147,12 @@ impl Config {
         if !(self.stage2.min_cue_signal >= 0.0 && self.stage2.min_cue_signal.is_finite()) {
             return fail("stage2.min_cue_signal", "must be a finite number >= 0");
         }
+        if !(self.stage2.newton_rest_tolerance >= 0.0 && self.stage2.newton_rest_tolerance.is_finite()) {
+            return fail(
+                "stage2.newton_rest_tolerance",
+                "must be 0 (held directions left as they are) or a positive share of the objective",
+            );
+        }
         if self.motion.model.is_empty() {
             return fail("motion.model", "must name a motion model");
         }
@@ -243,5 +249,10 @@ mod tests {
             assert_eq!(err.key.as_deref(), Some("stage2.cue_lever_bound"), "{bad}");
         }
         assert_eq!(parse("[stage2]\ncue_lever_bound = 0.0\n").unwrap().stage2.cue_lever_bound, 0.0);
+        for bad in ["-1e-3", "nan", "inf"] {
+            let err = parse(&format!("[stage2]\nnewton_rest_tolerance = {bad}\n")).unwrap_err();
+            assert_eq!(err.key.as_deref(), Some("stage2.newton_rest_tolerance"), "{bad}");
+        }
+        assert_eq!(parse("[stage2]\nnewton_rest_tolerance = 0.0\n").unwrap().stage2.newton_rest_tolerance, 0.0);
     }
 }

@@ -252,6 +252,11 @@ pub struct Stage2Config {
     /// translation), which the views hardly observe. With the measured cues in the objective
     /// they leave the motion prior out: it would only shrink the directions they move.
     pub newton_iterations: usize,
+    /// After the Newton steps, the directions they hold are set to rest (their components of
+    /// the scaled motion put to 0) if that raises the objective by at most this share of it
+    /// (0 = left where the Adam steps put them): what the views cannot tell apart is taken to be
+    /// still. One more Hessian (a gradient per motion parameter).
+    pub newton_rest_tolerance: f64,
 }
 
 impl Default for Stage2Config {
@@ -280,6 +285,7 @@ impl Default for Stage2Config {
             cue_residual_weights: true,
             initial_motion: None,
             newton_iterations: 5,
+            newton_rest_tolerance: 1e-3,
         }
     }
 }

@@ -6,7 +6,9 @@
 //! (Levenberg–Marquardt) and taken only where it lowers the objective, so the result is never
 //! worse than the start. Directions far flatter than the steepest can be held: there the
 //! objective hardly tells one point from another, and a Newton step would go a long way on the
-//! strength of a gradient that is mostly noise or bias.
+//! strength of a gradient that is mostly noise or bias. Held directions can then be set to rest
+//! (their components put to 0, the value a prior centred on rest would pick) where the objective
+//! hardly rises: the minimum-norm answer to what it cannot tell apart.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -22,6 +24,9 @@ pub struct NewtonSettings {
     /// Eigen-directions of the Hessian whose curvature is under this share of the steepest's
     /// are held where they are (0 holds none).
     pub min_curvature_ratio: f64,
+    /// After the steps, the held directions' components are set to 0 (rest) if that raises the
+    /// objective by at most this share of it; one more Hessian at the end (0 or less: never).
+    pub rest_tolerance: f64,
 }
 
 /// What the steps did.
@@ -29,12 +34,28 @@ pub struct NewtonSettings {
 pub struct NewtonReport {
     /// The objective at the start.
     pub start: f64,
-    /// The objective at the end (at most `start`).
+    /// The objective at the end: at most `start`, or at most `rest_tolerance` over the lowest
+    /// the steps reached where the held directions were set to rest.
     pub end: f64,
     /// Steps taken (lowering the objective).
     pub taken: usize,
     /// Evaluations of the objective and its gradient.
     pub evaluations: usize,
+    /// Whether the held directions were tried at rest, and how that went.
+    pub rest: Option<RestReport>,
+}
+
+/// The held directions set to rest after the steps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RestReport {
+    /// The objective after the steps.
+    pub before: f64,
+    /// The objective with the held directions at rest.
+    pub after: f64,
+    /// How far that moves the parameters (Euclidean, in their units).
+    pub distance: f64,
+    /// Whether the move was kept (`after` within the tolerance of `before`).
+    pub taken: bool,
 }
 
 /// Damping relative to the Hessian's mean absolute diagonal: first try (small enough to leave
@@ -45,6 +66,20 @@ const DAMPING_MAX: f64 = 1e3;
 /// Damping grows by this after a rejected step and shrinks by it after a taken one.
 const DAMPING_FACTOR: f64 = 10.0;
 
+/// The symmetrised Hessian at `x` (gradient `g`) from forward differences of the gradient, one
+/// evaluation per parameter.
+fn hessian_at(x: &DVector<f64>, g: &DVector<f64>, fd_step: f64, eval: &mut impl FnMut(&[f64]) -> (f64, Vec<f64>)) -> DMatrix<f64> {
+    let n = x.len();
+    let mut hessian = DMatrix::zeros(n, n);
+    for k in 0..n {
+        let mut probe = x.clone();
+        probe[k] += fd_step;
+        let (_, gk) = eval(probe.as_slice());
+        hessian.set_column(k, &((DVector::from_vec(gk) - g) / fd_step));
+    }
+    (&hessian + hessian.transpose()) * 0.5
+}
+
 /// Minimises `eval` (the objective and its gradient at a point) from `x0` by at most
 /// `settings.iterations` damped Newton steps; returns the lowest point found and a report. It
 /// stops early when no damping up to the most gives a lower objective.
@@ -53,21 +88,14 @@ pub fn newton_minimise(x0: &[f64], settings: &NewtonSettings, mut eval: impl FnM
     let mut x = DVector::from_column_slice(x0);
     let (mut f, g0) = eval(x.as_slice());
     let mut g = DVector::from_vec(g0);
-    let mut report = NewtonReport { start: f, end: f, taken: 0, evaluations: 1 };
+    let mut report = NewtonReport { start: f, end: f, taken: 0, evaluations: 1, rest: None };
     let mut damping = DAMPING_START;
     if n == 0 || !f.is_finite() {
         return (x0.to_vec(), report);
     }
     for _ in 0..settings.iterations {
-        let mut hessian = DMatrix::zeros(n, n);
-        for k in 0..n {
-            let mut probe = x.clone();
-            probe[k] += settings.fd_step;
-            let (_, gk) = eval(probe.as_slice());
-            report.evaluations += 1;
-            hessian.set_column(k, &((DVector::from_vec(gk) - &g) / settings.fd_step));
-        }
-        let hessian = (&hessian + hessian.transpose()) * 0.5;
+        let hessian = hessian_at(&x, &g, settings.fd_step, &mut eval);
+        report.evaluations += n;
         let diagonal_scale = (hessian.diagonal().abs().sum() / n as f64).max(f64::MIN_POSITIVE);
         let eigen = hessian.symmetric_eigen();
         let floor = settings.min_curvature_ratio * eigen.eigenvalues.max();
@@ -106,6 +134,26 @@ pub fn newton_minimise(x0: &[f64], settings: &NewtonSettings, mut eval: impl FnM
             break;
         }
     }
+    if settings.rest_tolerance > 0.0 && settings.min_curvature_ratio > 0.0 {
+        let eigen = hessian_at(&x, &g, settings.fd_step, &mut eval).symmetric_eigen();
+        report.evaluations += n;
+        let floor = settings.min_curvature_ratio * eigen.eigenvalues.max();
+        let mut candidate = x.clone();
+        for k in (0..n).filter(|&k| eigen.eigenvalues[k] < floor) {
+            let direction = eigen.eigenvectors.column(k);
+            candidate -= direction * direction.dot(&x);
+        }
+        let distance = (&candidate - &x).norm();
+        if distance > 0.0 {
+            let (fc, _) = eval(candidate.as_slice());
+            report.evaluations += 1;
+            let taken = fc.is_finite() && fc <= f + settings.rest_tolerance * f.abs();
+            report.rest = Some(RestReport { before: f, after: fc, distance, taken });
+            if taken {
+                (x, f) = (candidate, fc);
+            }
+        }
+    }
     report.end = f;
     (x.as_slice().to_vec(), report)
 }
@@ -114,7 +162,8 @@ pub fn newton_minimise(x0: &[f64], settings: &NewtonSettings, mut eval: impl FnM
 mod tests {
     use super::*;
 
-    const SETTINGS: NewtonSettings = NewtonSettings { iterations: 5, fd_step: 1e-4, max_step: 10.0, min_curvature_ratio: 0.0 };
+    const SETTINGS: NewtonSettings =
+        NewtonSettings { iterations: 5, fd_step: 1e-4, max_step: 10.0, min_curvature_ratio: 0.0, rest_tolerance: 0.0 };
 
     /// The offsets of `x` from the valley's minimum (1, 2) along its steep and its flat
     /// direction.
@@ -158,6 +207,39 @@ mod tests {
     }
 
     #[test]
+    fn a_held_direction_is_set_to_rest_only_where_the_objective_hardly_rises() {
+        // 1 + 0.5 (p^2 + 1e-4 (q - q_min)^2), p and q the valley's steep and flat offsets from
+        // (1, 2); rest (the origin) lies at p = -2.12, q = 0.71 from there. With the valley's
+        // minimum on the flat line through rest, rest costs nothing along it; off it, setting
+        // the flat offset to rest's costs 0.5e-4 (q_min - 0.71)^2.
+        let shifted = |q_min: f64| {
+            move |x: &[f64]| {
+                let (p, q) = offsets(x);
+                let (a, b) = (1.0, 1e-4);
+                let (dp, dq) = (a * p, b * (q - q_min));
+                (1.0 + 0.5 * (a * p * p + b * (q - q_min).powi(2)), vec![(dp + dq) / 2f64.sqrt(), (dp - dq) / 2f64.sqrt()])
+            }
+        };
+        let at_rest = offsets(&[0.0, 0.0]).1;
+        let rest = NewtonSettings { min_curvature_ratio: 1e-3, rest_tolerance: 1e-3, ..SETTINGS };
+        // The flat offset starts 3 from rest and the minimum is on rest's flat coordinate: set
+        // to rest, the objective falls.
+        let start = [-3.0, 5.0];
+        let (x, report) = newton_minimise(&start, &rest, shifted(at_rest));
+        let (p, q) = offsets(&x);
+        let rested = report.rest.expect("tried");
+        assert!(rested.taken && p.abs() < 1e-6 && (q - at_rest).abs() < 1e-6 && report.end <= 1.0 + 1e-9, "{x:?} {report:?}");
+        // The minimum 10 along the flat line from rest, and the start on its flat coordinate:
+        // rest costs 0.5e-4 x 100 = 5e-3 of 1, over the tolerance, so the held offset stays.
+        let (p0, q0) = (1.0, at_rest + 10.0);
+        let start = [1.0 + (p0 + q0) / 2f64.sqrt(), 2.0 + (p0 - q0) / 2f64.sqrt()];
+        let (x, report) = newton_minimise(&start, &rest, shifted(q0));
+        let rested = report.rest.expect("tried");
+        assert!(!rested.taken && (rested.after - rested.before - 5e-3).abs() < 1e-4, "{report:?}");
+        assert!((offsets(&x).1 - q0).abs() < 1e-9 && report.end == rested.before, "{x:?} {report:?}");
+    }
+
+    #[test]
     fn rosenbrock_only_ever_goes_down_and_ends_near_its_minimum() {
         let rosenbrock = |x: &[f64]| {
             let (a, b) = (1.0 - x[0], x[1] - x[0] * x[0]);
@@ -176,7 +258,7 @@ mod tests {
 
     #[test]
     fn a_step_is_never_longer_than_the_limit_and_a_flat_objective_is_left_where_it_is() {
-        let settings = NewtonSettings { iterations: 1, fd_step: 1e-3, max_step: 0.5, min_curvature_ratio: 0.0 };
+        let settings = NewtonSettings { iterations: 1, fd_step: 1e-3, max_step: 0.5, min_curvature_ratio: 0.0, rest_tolerance: 0.0 };
         let (x, report) = newton_minimise(&[0.0, 0.0], &settings, valley);
         assert!((x[0].hypot(x[1]) - 0.5).abs() < 1e-9 && report.taken == 1, "{x:?}");
         let (x, report) = newton_minimise(&[3.0, -1.0], &SETTINGS, |_| (2.0, vec![0.0, 0.0]));

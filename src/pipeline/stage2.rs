@@ -27,7 +27,8 @@ const NEWTON_MAX_STEP: f64 = 2.0;
 /// steepest's. On the 256 px suite the two flattest (about 1/300 of the steepest, mostly the
 /// motion prior's own curvature: tilt against vertical translation, pan against sideways
 /// translation) carried the steps that made the slow scenes worse, while the roll and v_z
-/// directions (1/80 and more) carried the gains (docs/results.md).
+/// directions (1/80 and more) carried the gains (docs/results.md). After the steps the held
+/// directions are set to rest where `[stage2] newton_rest_tolerance` allows.
 const NEWTON_MIN_CURVATURE_RATIO: f64 = 5e-3;
 
 /// How the run log's line with stage 2's cue check's verdict begins; readers of a log, such as
@@ -130,6 +131,7 @@ pub(super) fn run(
             fd_step: NEWTON_FD_STEP,
             max_step: NEWTON_MAX_STEP,
             min_curvature_ratio: NEWTON_MIN_CURVATURE_RATIO,
+            rest_tolerance: s.newton_rest_tolerance,
         },
     };
     // One phase of the fit, with its progress bar and its line in the log. The Newton steps go to
@@ -169,13 +171,20 @@ pub(super) fn run(
             stage2_ends.0,
             stage2_ends.1,
             fitted.newton.map_or(String::new(), |r| format!(
-                ", then {} of {} Newton steps taken over every band{}, {:.5} -> {:.5} ({} evaluations)",
+                ", then {} of {} Newton steps taken over every band{}, {:.5} -> {:.5} ({} evaluations){}",
                 r.taken,
                 s.newton_iterations,
                 if cue_term.is_some() { " (their objective leaves the motion prior out)" } else { "" },
                 r.start,
-                r.end,
-                r.evaluations
+                r.rest.map_or(r.end, |rest| rest.before),
+                r.evaluations,
+                r.rest.map_or(String::new(), |rest| format!(
+                    ", the directions they hold {} rest ({:.3} scaled units away, objective {:+.4} %, tolerance {} %)",
+                    if rest.taken { "set to" } else { "not set to" },
+                    rest.distance,
+                    100.0 * (rest.after - rest.before) / rest.before.abs().max(f64::MIN_POSITIVE),
+                    100.0 * s.newton_rest_tolerance
+                ))
             )),
             start.elapsed().as_secs_f64(),
             estimate_line(model, &fitted.parameters)
