@@ -14,7 +14,7 @@ mod schedule;
 mod stage;
 
 pub use mean_loss::MeanLoss;
-pub use newton::{NewtonReport, NewtonSettings, newton_minimise};
+pub use newton::{NewtonReport, NewtonSettings, RestReport, newton_minimise};
 pub use plan::{GroupPlan, Optimiser, Plan};
 pub use schedule::Schedule;
 pub use stage::{Objective, Stage, StepReport, optimise};

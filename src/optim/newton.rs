@@ -3,8 +3,8 @@
 //! per parameter, not per direction) and a decaying rate leave the estimate short along the
 //! flat one. The Hessian comes from finite differences of the gradient (one gradient per
 //! parameter), so any objective that has a gradient will do; each step is damped
-//! (Levenberg–Marquardt) and taken only where it lowers the objective, so the result is never
-//! worse than the start. Directions far flatter than the steepest can be held: there the
+//! (Levenberg–Marquardt) and taken only where it lowers the objective, so the steps never leave
+//! the result worse than the start. Directions far flatter than the steepest can be held: there the
 //! objective hardly tells one point from another, and a Newton step would go a long way on the
 //! strength of a gradient that is mostly noise or bias. Held directions can then be set to rest
 //! (their components put to 0, the value a prior centred on rest would pick) where the objective
@@ -81,8 +81,9 @@ fn hessian_at(x: &DVector<f64>, g: &DVector<f64>, fd_step: f64, eval: &mut impl 
 }
 
 /// Minimises `eval` (the objective and its gradient at a point) from `x0` by at most
-/// `settings.iterations` damped Newton steps; returns the lowest point found and a report. It
-/// stops early when no damping up to the most gives a lower objective.
+/// `settings.iterations` damped Newton steps; returns the lowest point found (or that point with
+/// its held directions at rest, where `settings.rest_tolerance` allows) and a report. It stops
+/// early when no damping up to the most gives a lower objective.
 pub fn newton_minimise(x0: &[f64], settings: &NewtonSettings, mut eval: impl FnMut(&[f64]) -> (f64, Vec<f64>)) -> (Vec<f64>, NewtonReport) {
     let n = x0.len();
     let mut x = DVector::from_column_slice(x0);
