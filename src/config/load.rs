@@ -253,6 +253,6 @@ mod tests {
             let err = parse(&format!("[stage2]\nnewton_rest_tolerance = {bad}\n")).unwrap_err();
             assert_eq!(err.key.as_deref(), Some("stage2.newton_rest_tolerance"), "{bad}");
         }
-        assert_eq!(parse("[stage2]\nnewton_rest_tolerance = 0.0\n").unwrap().stage2.newton_rest_tolerance, 0.0);
+        assert_eq!(parse("[stage2]\nnewton_rest_tolerance = 0.0\n").expect("0 turns the move off").stage2.newton_rest_tolerance, 0.0);
     }
 }
