@@ -272,7 +272,7 @@ mod tests {
     fn a_known_subpixel_shift_is_recovered() {
         let from = texture(64, 64, 0.0, 0.0);
         let to = SplineImage::new(&texture(64, 64, 2.37, -1.62));
-        let t = track(&from, &to, (32, 30), (2.0, -1.0), &TrackSettings::default()).unwrap();
+        let t = track(&from, &to, (32, 30), (2.0, -1.0), &TrackSettings::default()).expect("a textured patch is tracked");
         assert!((t.displacement.0 - 2.37).abs() < 2e-3 && (t.displacement.1 + 1.62).abs() < 2e-3, "{t:?}");
         assert!(t.residual_rms < 1e-3, "{t:?}");
     }
@@ -287,7 +287,7 @@ mod tests {
         let normal = (0.5f64.sqrt(), 0.5f64.sqrt());
         let settings = TrackSettings::default();
         let on = |x| track_warped(&from, &to, (x, 32), (0.0, 0.0), [[0.0; 2]; 2], Some(normal), &settings);
-        let (one, both) = (on(20).unwrap(), on(32).unwrap());
+        let (one, both) = (on(20).expect("tracked at 20"), on(32).expect("tracked at 32"));
         assert!(one.relative_residual() < 0.02, "{one:?}");
         assert!(both.relative_residual() > 0.2, "{both:?}");
     }
@@ -300,7 +300,8 @@ mod tests {
             Raster::from_f64_fn(48, 48, |x, y| 0.5 + 0.2 * (1.1 * (x - sx) + 0.3 * y).sin() + 0.2 * (0.9 * y - 0.8 * (x - sx)).cos())
         };
         for shift in [0.05, 0.1, -0.1, 0.2] {
-            let t = track(&fine(0.0), &SplineImage::new(&fine(shift)), (24, 24), (0.0, 0.0), &TrackSettings::default()).unwrap();
+            let t = track(&fine(0.0), &SplineImage::new(&fine(shift)), (24, 24), (0.0, 0.0), &TrackSettings::default())
+                .expect("a textured patch is tracked");
             assert!((t.displacement.0 - shift).abs() < 2.5e-3 && t.displacement.1.abs() < 2.5e-3, "{shift}: {t:?}");
         }
     }
@@ -315,8 +316,10 @@ mod tests {
         let from = Raster::from_f64_fn(64, 64, f);
         let to = SplineImage::new(&Raster::from_f64_fn(64, 64, |x, y| f(x - shift.0, c + (y - c - shift.1) / (1.0 + stretch))));
         let settings = TrackSettings::default();
-        let plain = track(&from, &to, (32, 32), (0.0, -2.0), &settings).unwrap().displacement;
-        let warped = track_warped(&from, &to, (32, 32), (0.0, -2.0), [[0.0, 0.0], [0.0, stretch]], None, &settings).unwrap().displacement;
+        let plain = track(&from, &to, (32, 32), (0.0, -2.0), &settings).expect("plain match").displacement;
+        let warped = track_warped(&from, &to, (32, 32), (0.0, -2.0), [[0.0, 0.0], [0.0, stretch]], None, &settings)
+            .expect("warped match")
+            .displacement;
         let miss = |d: (f64, f64)| (d.0 - shift.0).hypot(d.1 - shift.1);
         assert!(miss(warped) < 0.02, "warped {warped:?}");
         assert!(miss(plain) > 3.0 * miss(warped), "translation only {plain:?}, warped {warped:?}");
@@ -330,7 +333,7 @@ mod tests {
             let step = |t: f64| 0.5 * (1.0 + (2.0 * t).tanh());
             0.2 + 0.6 * step(x - 27.0) * step(y - 30.0)
         });
-        let (along_x, along_y) = pinning_centres(&corner, (32, 32), 8).unwrap();
+        let (along_x, along_y) = pinning_centres(&corner, (32, 32), 8).expect("a corner pins both ways");
         assert!((along_x.0 + 5.0).abs() < 0.2 && along_x.1 > 2.0, "{along_x:?}");
         assert!((along_y.1 + 2.0).abs() < 0.2 && along_y.0 > 1.0, "{along_y:?}");
     }
