@@ -144,6 +144,9 @@ impl Config {
         if !(0.0..=1.0).contains(&self.stage2.min_cue_support) {
             return fail("stage2.min_cue_support", "must be between 0 and 1");
         }
+        if !(0.0..=1.0).contains(&self.stage2.min_axial_support) {
+            return fail("stage2.min_axial_support", "must be between 0 and 1");
+        }
         if !(self.stage2.min_cue_signal >= 0.0 && self.stage2.min_cue_signal.is_finite()) {
             return fail("stage2.min_cue_signal", "must be a finite number >= 0");
         }
@@ -237,6 +240,10 @@ mod tests {
         assert_eq!(err.key.as_deref(), Some("stage2.cue_weight"));
         let err = parse("[stage2]\nmin_cue_support = 1.5\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.min_cue_support"));
+        for bad in ["1.5", "-0.1", "nan"] {
+            let err = parse(&format!("[stage2]\nmin_axial_support = {bad}\n")).unwrap_err();
+            assert_eq!(err.key.as_deref(), Some("stage2.min_axial_support"), "{bad}");
+        }
         let err = parse("[stage2]\nmin_cue_signal = -1.0\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.min_cue_signal"));
         for bad in ["0.5", "-1.0", "inf"] {

@@ -257,6 +257,12 @@ pub struct Stage2Config {
     /// (0 = left where the Adam steps put them): what the views cannot tell apart is taken to be
     /// still. One more Hessian (a gradient per motion parameter).
     pub newton_rest_tolerance: f64,
+    /// The least support (0..1) the measured cues must give the part of the kept motion along
+    /// and about the optical axis (forward translation, roll: the least observed rates), the
+    /// rest of the motion held, with a standard error from a jackknife over blocks of the image
+    /// (the cues' errors are shared within a region). Unless it is over it by two standard
+    /// errors, that part is set to 0. 0 = no such check.
+    pub min_axial_support: f64,
 }
 
 impl Default for Stage2Config {
@@ -286,6 +292,7 @@ impl Default for Stage2Config {
             initial_motion: None,
             newton_iterations: 5,
             newton_rest_tolerance: 1e-3,
+            min_axial_support: 0.5,
         }
     }
 }

@@ -61,29 +61,60 @@ impl CueSupport {
 /// residuals are clipped at three deviations. `None` with fewer than 100 cues the estimate
 /// images, or when it predicts no cue at all (no motion).
 pub fn cue_support(camera: &Camera, estimate: &MotionRecord, cues: &[Cue]) -> Option<CueSupport> {
-    // (measured, predicted) components, by axis.
-    let mut by_axis: BTreeMap<CueAxis, Vec<(f64, f64)>> = BTreeMap::new();
+    let (components, imaged) = weighed_components(camera, &MotionRecord::zero(), estimate, cues)?;
+    let (num, den) = components.iter().fold((0.0, 0.0), |(n, d), c| (n + c.weight * c.residual * c.part, d + c.weight * c.part * c.part));
+    (den > 1e-12).then(|| CueSupport { share: 1.0 + num / den, standard_error: den.sqrt().recip(), cues: imaged })
+}
+
+/// One measured component of a cue, weighed against an estimate and the part of its prediction
+/// that a smaller `base` motion lacks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct WeighedComponent {
+    /// The cue's patch centre in the central view (px).
+    pub at: (f64, f64),
+    /// The inverse variance of the residuals along its axis.
+    pub weight: f64,
+    /// Measured less predicted by the estimate, clipped at three deviations (px).
+    pub residual: f64,
+    /// Predicted by the estimate less predicted by `base` (px).
+    pub part: f64,
+}
+
+/// Each measured component of the cues that both `estimate` and `base` image, weighed as in
+/// [`cue_support`], with the number of cues they came from. The least-squares scale of the
+/// part `estimate` adds to `base` is then `1 + Σ w r p / Σ w p²`. `None` under 100 cues.
+pub(super) fn weighed_components(
+    camera: &Camera,
+    base: &MotionRecord,
+    estimate: &MotionRecord,
+    cues: &[Cue],
+) -> Option<(Vec<WeighedComponent>, usize)> {
+    // (position, measured, predicted, predicted by base) components, by axis.
+    let mut by_axis: BTreeMap<CueAxis, Vec<((f64, f64), f64, f64, f64)>> = BTreeMap::new();
     let mut imaged = 0;
     for cue in cues {
         let Some(predicted) = predicted_cue(camera, estimate, cue) else { continue };
+        let Some(from_base) = predicted_cue(camera, base, cue) else { continue };
         imaged += 1;
         for (axis, (ax, ay)) in cue.measured_axes() {
             let along = |(du, dv): (f64, f64)| ax * du + ay * dv;
-            by_axis.entry(axis).or_default().push((along(cue.offset), along(predicted)));
+            by_axis.entry(axis).or_default().push((cue.at, along(cue.offset), along(predicted), along(from_base)));
         }
     }
     if imaged < MIN_CUES {
         return None;
     }
-    let (mut num, mut den) = (0.0, 0.0);
-    for pairs in by_axis.values() {
-        let spread = (1.4826 * median_absolute_deviation(pairs.iter().map(|(m, p)| m - p).collect())).max(1e-6);
-        for (m, p) in pairs {
-            num += (m - p).clamp(-3.0 * spread, 3.0 * spread) * p / (spread * spread);
-            den += p * p / (spread * spread);
-        }
+    let mut components = Vec::new();
+    for rows in by_axis.values() {
+        let spread = (1.4826 * median_absolute_deviation(rows.iter().map(|(_, m, p, _)| m - p).collect())).max(1e-6);
+        components.extend(rows.iter().map(|&(at, m, p, b)| WeighedComponent {
+            at,
+            weight: (spread * spread).recip(),
+            residual: (m - p).clamp(-3.0 * spread, 3.0 * spread),
+            part: p - b,
+        }));
     }
-    (den > 1e-12).then(|| CueSupport { share: 1.0 + num / den, standard_error: den.sqrt().recip(), cues: imaged })
+    Some((components, imaged))
 }
 
 /// The median absolute deviation of `values` from their median.

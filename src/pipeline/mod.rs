@@ -5,6 +5,7 @@
 //! `cue_term.rs`.
 
 mod aperture;
+mod axial_check;
 mod box_filter;
 mod cue_support;
 mod cue_term;
@@ -24,6 +25,7 @@ mod view_tracking;
 mod visibility;
 
 pub use aperture::aperture_weights;
+pub use axial_check::{AxialSupport, axial_entries, axial_support};
 pub use cue_support::{CueSupport, cue_support};
 pub use cue_term::{CueTerm, residual_weights};
 pub use gaussian_init::{frequency_map, sample_gaussians};
@@ -37,7 +39,7 @@ pub use results::{LossCurves, PointCloud, RunResult, depth_map};
 pub use run_log::RunLog;
 pub use spline_image::SplineImage;
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
-pub use stage2::{CHECK_LINE, REFIT_CHECK_LINE};
+pub use stage2::{AXIAL_CHECK_LINE, CHECK_LINE, REFIT_CHECK_LINE};
 pub use stage2_fit::{MotionFit, Stage2Context, Stage2Fit, fit_stage2, motion_scales, pose_table};
 pub use view_tracking::{Track, TrackSettings, textured_points, track};
 pub use visibility::explained_mask;

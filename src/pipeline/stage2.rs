@@ -1,11 +1,12 @@
 //! Stage 2 as a run carries it out: the cues measured between the views, the photometric fit of
-//! the motion ([`super::fit_stage2`]), the check of its estimate against the cues, and the fit
-//! again with them of a motion they confirm, each with its line in the run's log.
+//! the motion ([`super::fit_stage2`]), the check of its estimate against the cues, the fit again
+//! with them of a motion they confirm, and the check of the kept motion's roll and forward motion
+//! ([`super::axial_support`]), each with its line in the run's log.
 
 use super::run_log::{RunLog, curve_ends, estimate_line};
 use super::{
-    Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Context, Stage2Fit, TrackedCues, column_views, cue_support,
-    drop_outlying_matches, fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
+    Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Context, Stage2Fit, TrackedCues, axial_entries, axial_support, column_views,
+    cue_support, drop_outlying_matches, fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
 };
 use crate::config::{Config, Stage2Config, ViewSelection};
 use crate::geometry::{Camera, ViewId};
@@ -35,6 +36,8 @@ const NEWTON_MIN_CURVATURE_RATIO: f64 = 5e-3;
 /// How the run log's line with stage 2's cue check's verdict begins; readers of a log, such as
 /// `rslf ablation`, find the verdict by it.
 pub const CHECK_LINE: &str = "stage 2 check: ";
+/// How the line with the verdict on the roll and forward motion of the kept motion begins.
+pub const AXIAL_CHECK_LINE: &str = "stage 2 check of the roll and forward motion: ";
 /// How the line with the verdict on the fit with the cues, after a check that did not confirm
 /// the motion, begins.
 pub const REFIT_CHECK_LINE: &str = "stage 2 check of the fit with the measured cues: ";
@@ -57,11 +60,12 @@ pub(super) fn run(
     log: &mut RunLog,
     curves: &mut LossCurves,
 ) -> MotionFit {
-    let Stage2Context { scene, camera, model, losses, device, .. } = *ctx;
+    let Stage2Context { scene, camera, model, .. } = *ctx;
     let s = &config.stage2;
     // The cue check judges a fitted motion; a motion given with no iterations is used as it is.
     let check = s.min_cue_support > 0.0 && s.iterations > 0;
-    let cues = (s.cue_weight > 0.0 || check).then(|| {
+    let check_axial_part = s.min_axial_support > 0.0 && s.iterations > 0;
+    let cues = (s.cue_weight > 0.0 || check || check_axial_part).then(|| {
         let start = Instant::now();
         let cue_views = stage2_views(scene, s.cue_views);
         let TrackedCues { mut cues, base_lever, large_lever } =
@@ -92,10 +96,37 @@ pub(super) fn run(
         }
         cues
     });
+    let fitted = fit_and_check(config, ctx, gaussians, start_values, cues.as_deref(), log, curves);
+    match cues {
+        Some(cues) if check_axial_part => check_axial(fitted, model, camera, &two_way(&cues), s.min_axial_support, log),
+        _ => fitted,
+    }
+}
+
+/// The patches textured both ways alone: the cues of edges and stripes carry biases of a few
+/// percent, enough to bear out a still scene's drift (`objects_static`: 0.55 ± 0.01 with them,
+/// -0.01 ± 0.02 without; docs/results.md), so the checks judge without them.
+fn two_way(cues: &[Cue]) -> Vec<Cue> {
+    cues.iter().copied().filter(|c| c.across.is_none()).collect()
+}
+
+/// The fits of [`run`] and the cue check between them, with the cues `cues` measured where
+/// the config asks for them.
+fn fit_and_check(
+    config: &Config,
+    ctx: &Stage2Context,
+    gaussians: Gaussians,
+    start_values: &[f64],
+    cues: Option<&[Cue]>,
+    log: &mut RunLog,
+    curves: &mut LossCurves,
+) -> MotionFit {
+    let Stage2Context { scene, camera, model, losses, device, .. } = *ctx;
+    let s = &config.stage2;
+    let check = s.min_cue_support > 0.0 && s.iterations > 0;
     // The term is built where a fit uses it: a motion the check sets to none needs none.
     let cue_term = || {
-        cues.as_ref()
-            .filter(|_| s.cue_weight > 0.0)
+        cues.filter(|_| s.cue_weight > 0.0)
             .map(|cues| CueTerm::new(cues, camera, s.cue_weight as f32, CUE_HUBER_PX, s.timing_iterations, s.cue_residual_weights, device))
     };
     let mut views = stage2_views(scene, s.views);
@@ -192,16 +223,13 @@ pub(super) fn run(
         ));
         fitted
     };
-    let checked_cues = cues.as_ref().filter(|_| check);
+    let checked_cues = cues.filter(|_| check);
     let first_cue_term = if checked_cues.is_some() { None } else { cue_term() };
     let second_fit = checked_cues.is_some() && s.cue_weight > 0.0;
     let mut fitted = phase("fit", gaussians.clone(), first_cue_term.as_ref(), !second_fit, log);
     curves.push(("stage2".to_string(), fitted.curve.clone()));
     let Some(checked) = checked_cues else { return fitted };
-    // The check judges with the patches textured both ways alone: the cues of edges and stripes
-    // carry biases of a few percent, enough to bear out a still scene's drift
-    // (`objects_static`: 0.55 ± 0.01 with them, -0.01 ± 0.02 without; docs/results.md).
-    let two_way: Vec<Cue> = checked.iter().copied().filter(|c| c.across.is_none()).collect();
+    let two_way = two_way(checked);
     let second_chance = s.min_cue_signal > 0.0 && s.cue_weight > 0.0;
     let verdict = check_motion(&mut fitted, model, camera, &two_way, s.min_cue_support, second_chance, log);
     let refit_due = verdict == Some(true) || (verdict == Some(false) && second_chance);
@@ -289,4 +317,35 @@ pub(super) fn check_motion(
     let then = if second_chance { "unless the fit with the measured cues stands clear of their scatter" } else { "no motion kept" };
     log.push(format!("{CHECK_LINE}{shown}, {verdict} {min_support}: taken for a drift of the fit, {then}"));
     Some(false)
+}
+
+/// Keeps the part of the kept motion along and about the optical axis only when the cues
+/// confirm it at `min_support` with the block jackknife's standard error
+/// ([`super::AxialSupport::confirms`]), else sets it to 0, and says in the log what they show.
+/// A motion with no such part, or too few cues or blocks to judge it, is kept as it is.
+fn check_axial(
+    mut fitted: MotionFit,
+    model: &dyn MotionModel,
+    camera: &Camera,
+    cues: &[Cue],
+    min_support: f64,
+    log: &mut RunLog,
+) -> MotionFit {
+    let Some(support) = axial_support(camera, model, &fitted.parameters, cues) else { return fitted };
+    let confirmed = support.confirms(min_support);
+    if !confirmed {
+        axial_entries(model).into_iter().for_each(|i| fitted.parameters[i] = 0.0);
+    }
+    log.push(format!(
+        "{AXIAL_CHECK_LINE}the measured cues of patches textured both ways bear out {:.2} (± {:.2} over {} blocks of the image) of the roll and forward motion, the rest held; {}",
+        support.share,
+        support.standard_error,
+        support.blocks,
+        if confirmed {
+            format!("clearly over {min_support}: kept")
+        } else {
+            format!("not clearly over {min_support}: set to 0; estimate {}", estimate_line(model, &fitted.parameters))
+        }
+    ));
+    fitted
 }
