@@ -89,8 +89,9 @@ pub(super) fn weighed_components(
     estimate: &MotionRecord,
     cues: &[Cue],
 ) -> Option<(Vec<WeighedComponent>, usize)> {
-    // (position, measured, predicted, predicted by base) components, by axis.
-    let mut by_axis: BTreeMap<CueAxis, Vec<((f64, f64), f64, f64, f64)>> = BTreeMap::new();
+    // Each component's position and (measured, predicted, predicted by base) values, by axis.
+    type Row = ((f64, f64), [f64; 3]);
+    let mut by_axis: BTreeMap<CueAxis, Vec<Row>> = BTreeMap::new();
     let mut imaged = 0;
     for cue in cues {
         let Some(predicted) = predicted_cue(camera, estimate, cue) else { continue };
@@ -98,7 +99,7 @@ pub(super) fn weighed_components(
         imaged += 1;
         for (axis, (ax, ay)) in cue.measured_axes() {
             let along = |(du, dv): (f64, f64)| ax * du + ay * dv;
-            by_axis.entry(axis).or_default().push((cue.at, along(cue.offset), along(predicted), along(from_base)));
+            by_axis.entry(axis).or_default().push((cue.at, [along(cue.offset), along(predicted), along(from_base)]));
         }
     }
     if imaged < MIN_CUES {
@@ -106,8 +107,8 @@ pub(super) fn weighed_components(
     }
     let mut components = Vec::new();
     for rows in by_axis.values() {
-        let spread = (1.4826 * median_absolute_deviation(rows.iter().map(|(_, m, p, _)| m - p).collect())).max(1e-6);
-        components.extend(rows.iter().map(|&(at, m, p, b)| WeighedComponent {
+        let spread = (1.4826 * median_absolute_deviation(rows.iter().map(|(_, [m, p, _])| m - p).collect())).max(1e-6);
+        components.extend(rows.iter().map(|&(at, [m, p, b])| WeighedComponent {
             at,
             weight: (spread * spread).recip(),
             residual: (m - p).clamp(-3.0 * spread, 3.0 * spread),

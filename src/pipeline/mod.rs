@@ -1,8 +1,8 @@
 //! The RSLF composition: stage 1 (initial disparity, Gaussian sampling, fit: `stage1.rs`), then
 //! stage 2 (the motion: `stage2.rs`) where the scene allows it, and the result, with the settings
 //! both draw from a config. The optimisation loops are `stage1_fit.rs` and `stage2_fit.rs`; the
-//! cues stage 2 measures between the views and weighs are `measured_cues.rs`, `cue_support.rs` and
-//! `cue_term.rs`.
+//! cues stage 2 measures between the views and weighs are `measured_cues.rs`, `cue_support.rs`,
+//! `axial_check.rs` and `cue_term.rs`.
 
 mod aperture;
 mod axial_check;
