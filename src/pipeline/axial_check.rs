@@ -88,23 +88,11 @@ fn block_jackknife(camera: &Camera, components: &[WeighedComponent]) -> Option<A
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::ViewGrid;
     use crate::io::MotionRecord;
     use crate::model::motion::ConstantVelocity;
+    use crate::pipeline::cue_support::tests::camera;
     use crate::pipeline::predicted_cue;
     use crate::random::Rng;
-
-    fn camera() -> Camera {
-        Camera {
-            grid: ViewGrid { rows: 9, cols: 9 },
-            width: 256,
-            height: 256,
-            f_px: 360.0,
-            baseline_m: 0.03,
-            focus_m: 3.0,
-            line_time_s: 1e-4,
-        }
-    }
 
     /// Two-way cues on a 20 x 20 grid of each corner, with disparities from -1.5 to 1.5 px,
     /// measured under `truth(x, y)` (the motion at the patch) with Gaussian noise of 0.02 px.

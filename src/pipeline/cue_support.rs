@@ -130,12 +130,13 @@ fn median_absolute_deviation(mut values: Vec<f64>) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::geometry::ViewGrid;
     use crate::random::Rng;
 
-    fn camera() -> Camera {
+    /// A 256 px, 9 x 9 capture with a rolling shutter (also the roll-and-forward check's tests').
+    pub(in crate::pipeline) fn camera() -> Camera {
         Camera {
             grid: ViewGrid { rows: 9, cols: 9 },
             width: 256,
