@@ -33,6 +33,15 @@ fn the_image_space_motion_error_takes_the_true_disparity_where_the_true_depth_is
     let (from_depth, stdout) = image_error(&scene, &result);
     let from_depth = from_depth.unwrap_or_else(|| panic!("no image-space error: {stdout}"));
     assert!(from_depth > 0.1, "half the motion is off by half its shift: {stdout}");
+    // The split by texture in metrics.json covers every point: its groups' squared errors,
+    // weighed by their shares, add up to the whole error's.
+    let (ok, _, stderr) = rslf(&["eval", "--scene", scene.to_str().unwrap(), "--result", result.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    let metrics: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(result.join("metrics.json")).unwrap()).unwrap();
+    let split = &metrics["motion"]["texture"];
+    let squares = |group: &str| split[group]["share"].as_f64().unwrap() * split[group]["rms_error_px"].as_f64().map_or(0.0, |e| e * e);
+    let added = (squares("one_way") + squares("both_ways") + squares("flat")).sqrt();
+    assert!((added - from_depth).abs() < 2e-3, "{split} against {from_depth} px");
     std::fs::remove_file(scene.join("gt_depth_lowres.pfm")).unwrap();
     let (from_disparity, stdout) = image_error(&scene, &result);
     let from_disparity = from_disparity.unwrap_or_else(|| panic!("no image-space error without gt_depth_lowres.pfm: {stdout}"));

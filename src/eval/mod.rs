@@ -4,6 +4,7 @@ mod metrics;
 mod motion_error;
 mod observability;
 mod report;
+mod texture_error;
 
 pub use metrics::{
     BADPIX_THRESHOLDS, DepthMetrics, DisparityMetrics, HCI_BORDER_PX, ParameterError, depth_metrics, disparity_metrics, evaluation_region,
@@ -12,6 +13,7 @@ pub use metrics::{
 pub use motion_error::{ImageMotionError, image_motion_error};
 pub use observability::{Observability, PARAMETER_NAMES, observability};
 pub use report::{DepthReport, EvalReport, MotionReport};
+pub use texture_error::{TextureGroup, TextureSplit, texture_error};
 
 /// `rslf eval` compares motions on every 4th ground-truth pixel each way.
 pub const MOTION_POINT_STRIDE: usize = 4;
@@ -123,6 +125,7 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
                 parameters: motion_parameter_errors(e, t),
                 image: points.and_then(|(cam, (z, _))| image_motion_error(cam, e, t, z, MOTION_POINT_STRIDE)),
                 observability: points.and_then(|(cam, (z, _))| observability(cam, t, z, OBSERVABILITY_POINT_STRIDE)),
+                texture: points.and_then(|(cam, (z, _))| texture_error(cam, e, t, z, scene.central(), MOTION_POINT_STRIDE)),
             })
         }
         (None, Some(_)) => {

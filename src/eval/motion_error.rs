@@ -20,10 +20,69 @@ pub struct ImageMotionError {
     pub points: usize,
 }
 
-/// Compares `estimate` with `truth` on the t = 0 points of `gt_depth` (every `stride`-th pixel
-/// each way, finite positive depth), in the central view and the four corners; each point is
-/// imaged at the read-out time of the row it lands on. Points that either motion cannot image
-/// (behind the camera, no settled row) are left out. `None` when no point is left.
+/// One t = 0 point imaged in one view under the true and the estimated motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct PointError {
+    /// Where the captured central view shows it: its position there under the true motion,
+    /// rounded (its pixel at t = 0, `gt_depth`'s grid, where the truth cannot image it there).
+    pub seen_at: (usize, usize),
+    /// Index of the view.
+    pub view: usize,
+    /// Its true position less its estimated one (px).
+    pub error: (f64, f64),
+    /// Its true position less its position with no motion (px).
+    pub shift: (f64, f64),
+}
+
+/// The t = 0 points of `gt_depth` (every `stride`-th pixel each way, finite positive depth)
+/// imaged in the central view and the four corners, in that order, each at the read-out time of
+/// the row it lands on under `truth`, `estimate` and no motion. Points that any of the three
+/// cannot image (behind the camera, no settled row) are left out; a grid without a central
+/// view gives none.
+pub(super) fn point_errors(
+    camera: &Camera,
+    estimate: &MotionRecord,
+    truth: &MotionRecord,
+    gt_depth: &Raster,
+    stride: usize,
+) -> Vec<PointError> {
+    let stride = stride.max(1);
+    let zero = MotionRecord::zero();
+    let Some(central) = camera.grid.central() else { return Vec::new() };
+    let mut views = vec![central];
+    views.extend(camera.grid.corners());
+    let points: Vec<_> = (0..gt_depth.height)
+        .step_by(stride)
+        .flat_map(|v| (0..gt_depth.width).step_by(stride).map(move |u| (u, v)))
+        .filter_map(|(u, v)| {
+            let z = gt_depth.data[v * gt_depth.width + u] as f64;
+            (z.is_finite() && z > 0.0).then(|| ((u, v), camera.back_project(u as f64, v as f64, z)))
+        })
+        .map(|(pixel, p)| {
+            let inside =
+                |&(x, y, _): &(f64, f64, f64)| x >= 0.0 && y >= 0.0 && x <= (camera.width - 1) as f64 && y <= (camera.height - 1) as f64;
+            let seen = rs_project(camera, truth, central, &p).filter(inside);
+            (seen.map_or(pixel, |(x, y, _)| (x.round() as usize, y.round() as usize)), p)
+        })
+        .collect();
+    let mut out = Vec::new();
+    for view in views {
+        for (seen_at, p) in &points {
+            let imaged = |m: &MotionRecord| rs_project(camera, m, view, p);
+            let (Some(t), Some(e), Some(s)) = (imaged(truth), imaged(estimate), imaged(&zero)) else { continue };
+            out.push(PointError {
+                seen_at: *seen_at,
+                view: camera.grid.index(view),
+                error: (t.0 - e.0, t.1 - e.1),
+                shift: (t.0 - s.0, t.1 - s.1),
+            });
+        }
+    }
+    out
+}
+
+/// Compares `estimate` with `truth` on the t = 0 points of `gt_depth` ([`point_errors`]), in the
+/// central view and the four corners. `None` when no point is left.
 pub fn image_motion_error(
     camera: &Camera,
     estimate: &MotionRecord,
@@ -31,38 +90,23 @@ pub fn image_motion_error(
     gt_depth: &Raster,
     stride: usize,
 ) -> Option<ImageMotionError> {
-    let stride = stride.max(1);
-    let zero = MotionRecord::zero();
-    let mut views = vec![camera.grid.central()?];
-    views.extend(camera.grid.corners());
-    let points: Vec<_> = (0..gt_depth.height)
-        .step_by(stride)
-        .flat_map(|v| (0..gt_depth.width).step_by(stride).map(move |u| (u, v)))
-        .filter_map(|(u, v)| {
-            let z = gt_depth.data[v * gt_depth.width + u] as f64;
-            (z.is_finite() && z > 0.0).then(|| camera.back_project(u as f64, v as f64, z))
-        })
-        .collect();
-    let (mut err2, mut shift2, mut count) = (0.0, 0.0, 0usize);
-    let mut per_view_px = Vec::new();
-    for view in views {
-        let (mut view_err2, mut view_count) = (0.0, 0usize);
-        for p in &points {
-            let imaged = |m: &MotionRecord| rs_project(camera, m, view, p);
-            let (Some(t), Some(e), Some(s)) = (imaged(truth), imaged(estimate), imaged(&zero)) else { continue };
-            let d2 = (t.0 - e.0).powi(2) + (t.1 - e.1).powi(2);
-            view_err2 += d2;
-            view_count += 1;
-            shift2 += (t.0 - s.0).powi(2) + (t.1 - s.1).powi(2);
+    let points = point_errors(camera, estimate, truth, gt_depth, stride);
+    let norm2 = |d: (f64, f64)| d.0 * d.0 + d.1 * d.1;
+    let mut per_view: Vec<(usize, f64, usize)> = Vec::new();
+    for p in &points {
+        match per_view.last_mut() {
+            Some((view, err2, n)) if *view == p.view => {
+                *err2 += norm2(p.error);
+                *n += 1;
+            }
+            _ => per_view.push((p.view, norm2(p.error), 1)),
         }
-        err2 += view_err2;
-        count += view_count;
-        per_view_px.push((camera.grid.index(view), (view_err2 / view_count.max(1) as f64).sqrt()));
     }
+    let count = points.len();
     (count > 0).then(|| ImageMotionError {
-        rms_error_px: (err2 / count as f64).sqrt(),
-        rms_true_shift_px: (shift2 / count as f64).sqrt(),
-        per_view_px,
+        rms_error_px: (points.iter().map(|p| norm2(p.error)).sum::<f64>() / count as f64).sqrt(),
+        rms_true_shift_px: (points.iter().map(|p| norm2(p.shift)).sum::<f64>() / count as f64).sqrt(),
+        per_view_px: per_view.into_iter().map(|(view, err2, n)| (view, (err2 / n as f64).sqrt())).collect(),
         points: count / 5,
     })
 }

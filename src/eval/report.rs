@@ -3,6 +3,7 @@
 use super::metrics::{DepthMetrics, DisparityMetrics, ParameterError};
 use super::motion_error::ImageMotionError;
 use super::observability::Observability;
+use super::texture_error::{TextureGroup, TextureSplit};
 use crate::io::{IoError, IoResult, write_atomic};
 use serde::Serialize;
 use std::fmt;
@@ -34,6 +35,9 @@ pub struct MotionReport {
     /// How strongly the scene's cue observes each direction of constant-velocity motion, when
     /// the scene has a camera and ground-truth depth.
     pub observability: Option<Observability>,
+    /// The image-space error split by the central view's texture around each point (where it
+    /// runs one way, the component along it is what the views cannot show).
+    pub texture: Option<TextureSplit>,
 }
 
 /// Everything `rslf eval` measured. Non-finite numbers are written as `null`.
@@ -118,6 +122,24 @@ impl fmt::Display for EvalReport {
                 let dirs: Vec<String> =
                     o.directions.iter().take(3).map(|(r, d)| format!("{} ({})", num(*r, 4), Observability::describe(d))).collect();
                 writeln!(f, "motion     weakest directions: {}", dirs.join(", "))?;
+            }
+            if let Some(t) = &m.texture {
+                let group = |g: &TextureGroup| format!("{:.1} %", 100.0 * g.share);
+                let error = |g: &TextureGroup| if g.share > 0.0 { format!("{} px", num(g.rms_error_px, 3)) } else { "none".to_string() };
+                let one_way = if t.one_way.share > 0.0 {
+                    format!("{} ({} px along it, {} px across)", error(&t.one_way), num(t.along_px, 3), num(t.across_px, 3))
+                } else {
+                    error(&t.one_way)
+                };
+                writeln!(
+                    f,
+                    "motion     image-space error by the central view's texture: runs one way {}: {one_way}; both ways {}: {}; flat {}: {}",
+                    group(&t.one_way),
+                    group(&t.both_ways),
+                    error(&t.both_ways),
+                    group(&t.flat),
+                    error(&t.flat)
+                )?;
             }
         }
         for note in &self.notes {
