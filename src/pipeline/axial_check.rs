@@ -15,7 +15,8 @@ use super::measured_cues::Cue;
 use crate::geometry::Camera;
 use crate::model::motion::MotionModel;
 
-/// The central view is cut into this many blocks along each side for the jackknife.
+/// The central view is cut into this many columns of blocks for the jackknife, and this many
+/// rows per group of axial entries ([`axial_groups`]).
 pub const BLOCKS_PER_SIDE: usize = 4;
 /// Fewest blocks with cues a judgement is made from.
 const MIN_BLOCKS: usize = 6;
@@ -28,7 +29,7 @@ pub struct AxialSupport {
     pub share: f64,
     /// Its standard error: the delete-one-block jackknife's over the blocks with cues.
     pub standard_error: f64,
-    /// Blocks of the central view with cues.
+    /// Blocks of the central view with cues that the part moves.
     pub blocks: usize,
 }
 
@@ -40,36 +41,71 @@ impl AxialSupport {
     }
 }
 
-/// The entries of `model`'s parameter vector along or about the optical axis (Z).
-pub fn axial_entries(model: &dyn MotionModel) -> Vec<usize> {
-    model.parameters().iter().enumerate().filter(|(_, k)| k.axis == 2).map(|(i, _)| i).collect()
+/// The entries of `model`'s parameter vector along or about the optical axis (Z), in groups:
+/// the k-th entry of each kind (quantity and order) goes to group k. A model with one set of
+/// rates has one group; `piecewise_constant` has one per segment, so that each segment's roll
+/// and forward motion is judged by the cues of the rows it moves.
+pub fn axial_groups(model: &dyn MotionModel) -> Vec<Vec<usize>> {
+    let kinds = model.parameters();
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    for (i, kind) in kinds.iter().enumerate().filter(|(_, k)| k.axis == 2) {
+        let k = kinds[..i].iter().filter(|&earlier| earlier == kind).count();
+        if groups.len() <= k {
+            groups.resize(k + 1, Vec::new());
+        }
+        groups[k].push(i);
+    }
+    groups
 }
 
-/// The support `cues` give the axial entries of `parameters` (SI) against the same motion with
-/// them at 0. `None` when the model has no such entries, they are all 0, fewer than 100 cues are
-/// imaged or fewer than six blocks of the view hold cues.
-pub fn axial_support(camera: &Camera, model: &dyn MotionModel, parameters: &[f64], cues: &[Cue]) -> Option<AxialSupport> {
-    let axial = axial_entries(model);
-    if axial.iter().all(|&i| parameters[i] == 0.0) {
-        return None;
-    }
-    let mut without = parameters.to_vec();
-    axial.iter().for_each(|&i| without[i] = 0.0);
-    let (components, _) = weighed_components(camera, &model.record(&without), &model.record(parameters), cues)?;
-    block_jackknife(camera, &components)
+/// One group of axial entries and what the cues show of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxialJudgement {
+    /// The group's index among [`axial_groups`] (the segment of a piecewise model).
+    pub group: usize,
+    /// The group's entries in the parameter vector.
+    pub entries: Vec<usize>,
+    /// The cues' support; `None` where fewer than 100 cues are imaged or fewer than six blocks
+    /// hold cues that the group moves.
+    pub support: Option<AxialSupport>,
+}
+
+/// The support `cues` give each group of axial entries of `parameters` (SI; [`axial_groups`])
+/// against the same motion with that group at 0 and the rest as it is, with the view cut into
+/// 4 columns and 4 rows per group of blocks. One judgement per group with an entry that is not
+/// 0, in the groups' order.
+pub fn axial_support(camera: &Camera, model: &dyn MotionModel, parameters: &[f64], cues: &[Cue]) -> Vec<AxialJudgement> {
+    let groups = axial_groups(model);
+    let block_rows = BLOCKS_PER_SIDE * groups.len().max(1);
+    let estimate = model.record(parameters);
+    groups
+        .into_iter()
+        .enumerate()
+        .filter(|(_, entries)| entries.iter().any(|&i| parameters[i] != 0.0))
+        .map(|(group, entries)| {
+            let mut without = parameters.to_vec();
+            entries.iter().for_each(|&i| without[i] = 0.0);
+            let support = weighed_components(camera, &model.record(&without), &estimate, cues)
+                .and_then(|(components, _)| block_jackknife(camera, &components, block_rows));
+            AxialJudgement { group, entries, support }
+        })
+        .collect()
 }
 
 /// The least-squares share `1 + Σ w r p / Σ w p²` of the components and its delete-one-block
-/// jackknife standard error, `sqrt((B-1)/B Σ (s₋ᵦ - s̄)²)`.
-fn block_jackknife(camera: &Camera, components: &[WeighedComponent]) -> Option<AxialSupport> {
-    let side = |x: f64, extent: usize| ((x / extent as f64 * BLOCKS_PER_SIDE as f64).floor().max(0.0) as usize).min(BLOCKS_PER_SIDE - 1);
-    let mut sums = vec![(0.0, 0.0); BLOCKS_PER_SIDE * BLOCKS_PER_SIDE];
+/// jackknife standard error, `sqrt((B-1)/B Σ (s₋ᵦ - s̄)²)`, over `BLOCKS_PER_SIDE` columns and
+/// `block_rows` rows of blocks. Blocks whose `Σ w p²` is under 1e-9 of the largest block's hold
+/// no cue the part moves and are left out.
+fn block_jackknife(camera: &Camera, components: &[WeighedComponent], block_rows: usize) -> Option<AxialSupport> {
+    let index = |x: f64, extent: usize, blocks: usize| ((x / extent as f64 * blocks as f64).floor().max(0.0) as usize).min(blocks - 1);
+    let mut sums = vec![(0.0, 0.0); BLOCKS_PER_SIDE * block_rows];
     for c in components {
-        let block = side(c.at.1, camera.height) * BLOCKS_PER_SIDE + side(c.at.0, camera.width);
+        let block = index(c.at.1, camera.height, block_rows) * BLOCKS_PER_SIDE + index(c.at.0, camera.width, BLOCKS_PER_SIDE);
         sums[block].0 += c.weight * c.residual * c.part;
         sums[block].1 += c.weight * c.part * c.part;
     }
-    let filled: Vec<(f64, f64)> = sums.into_iter().filter(|&(_, den)| den > 0.0).collect();
+    let largest = sums.iter().map(|&(_, den)| den).fold(0.0, f64::max);
+    let filled: Vec<(f64, f64)> = sums.into_iter().filter(|&(_, den)| den > 1e-9 * largest).collect();
     let (num, den) = filled.iter().fold((0.0, 0.0), |(n, d), &(bn, bd)| (n + bn, d + bd));
     if filled.len() < MIN_BLOCKS || den <= 1e-12 {
         return None;
@@ -88,8 +124,9 @@ fn block_jackknife(camera: &Camera, components: &[WeighedComponent]) -> Option<A
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::readout_interval;
     use crate::io::MotionRecord;
-    use crate::model::motion::ConstantVelocity;
+    use crate::model::motion::{ConstantVelocity, PiecewiseConstant};
     use crate::pipeline::cue_support::tests::camera;
     use crate::pipeline::predicted_cue;
     use crate::random::Rng;
@@ -118,10 +155,18 @@ mod tests {
         ConstantVelocity.record(p)
     }
 
+    /// The one judgement of a constant-velocity estimate.
+    fn judged(parameters: &[f64; 6], measured: &[Cue]) -> AxialSupport {
+        let judgements = axial_support(&camera(), &ConstantVelocity, parameters, measured);
+        assert_eq!(judgements.len(), 1, "{judgements:?}");
+        assert_eq!(judgements[0].entries, vec![2, 5]);
+        judgements[0].support.expect("judged")
+    }
+
     #[test]
     fn a_true_roll_and_forward_motion_is_confirmed() {
         let truth = [0.0, 0.2, 0.6, 0.5, 0.0, 3.0];
-        let support = axial_support(&camera(), &ConstantVelocity, &truth, &cues(|_, _| record(&truth))).expect("judged");
+        let support = judged(&truth, &cues(|_, _| record(&truth)));
         assert!((support.share - 1.0).abs() < 0.05, "{support:?}");
         assert!(support.confirms(0.5) && support.blocks == 16, "{support:?}");
     }
@@ -135,7 +180,7 @@ mod tests {
         // rest shows none of it.
         let bottom = [0.0, 0.1, 0.15, 0.4, 0.0, -1.8];
         let measured = cues(|_, y| record(if y >= 192.0 { &bottom } else { &truth }));
-        let support = axial_support(&camera(), &ConstantVelocity, &spurious, &measured).expect("judged");
+        let support = judged(&spurious, &measured);
         // Taken as independent, the cues would confirm it: their standard error is small.
         let without = [0.0, 0.1, 0.0, 0.4, 0.0, 0.0];
         let (components, _) = weighed_components(&camera(), &record(&without), &record(&spurious), &measured).unwrap();
@@ -149,7 +194,26 @@ mod tests {
     #[test]
     fn a_motion_without_an_axial_part_is_not_judged() {
         let pan = [0.0, 0.1, 0.0, 0.4, 0.0, 0.0];
-        assert_eq!(axial_support(&camera(), &ConstantVelocity, &pan, &cues(|_, _| record(&pan))), None);
-        assert_eq!(axial_entries(&ConstantVelocity), vec![2, 5]);
+        assert_eq!(axial_support(&camera(), &ConstantVelocity, &pan, &cues(|_, _| record(&pan))), vec![]);
+        assert_eq!(axial_groups(&ConstantVelocity), vec![vec![2, 5]]);
+    }
+
+    #[test]
+    fn each_segment_s_roll_and_forward_motion_is_judged_by_its_own_rows() {
+        let cam = camera();
+        let model = PiecewiseConstant { segments: 2, readout: readout_interval(cam.height, cam.line_time_s) };
+        assert_eq!(axial_groups(&model), vec![vec![2, 5], vec![8, 11]]);
+        // A pan with a sideways slide throughout, and a roll with a forward motion in the second
+        // half of the read-out (the lower half of the image) only.
+        let truth = [0.0, 0.1, 0.0, 0.4, 0.0, 0.0, 0.0, 0.1, 0.6, 0.4, 0.0, 3.0];
+        // The estimate adds a roll and a forward motion to the first half.
+        let estimate = [0.0, 0.1, 0.3, 0.4, 0.0, 2.0, 0.0, 0.1, 0.6, 0.4, 0.0, 3.0];
+        let judgements = axial_support(&cam, &model, &estimate, &cues(|_, _| model.record(&truth)));
+        assert_eq!(judgements.iter().map(|j| (j.group, j.entries.clone())).collect::<Vec<_>>(), vec![(0, vec![2, 5]), (1, vec![8, 11])]);
+        let (first, second) = (judgements[0].support.expect("judged"), judgements[1].support.expect("judged"));
+        assert!(!first.confirms(0.5) && first.share.abs() < 0.1, "{first:?}");
+        assert!(second.confirms(0.5) && (second.share - 1.0).abs() < 0.1, "{second:?}");
+        // Each is judged over the blocks of the rows it moves: 4 columns by 4 rows of the 8.
+        assert!(first.blocks <= 20 && second.blocks <= 20, "{first:?} {second:?}");
     }
 }

@@ -25,7 +25,7 @@ mod view_tracking;
 mod visibility;
 
 pub use aperture::aperture_weights;
-pub use axial_check::{AxialSupport, axial_entries, axial_support};
+pub use axial_check::{AxialJudgement, AxialSupport, axial_groups, axial_support};
 pub use cue_support::{CueSupport, cue_support};
 pub use cue_term::{CueTerm, residual_weights};
 pub use gaussian_init::{frequency_map, sample_gaussians};

@@ -5,8 +5,8 @@
 
 use super::run_log::{RunLog, curve_ends, estimate_line};
 use super::{
-    Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Context, Stage2Fit, TrackedCues, axial_entries, axial_support, column_views,
-    cue_support, drop_outlying_matches, fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
+    Cue, CueTerm, LearningRates, LossCurves, MotionFit, Stage2Context, Stage2Fit, TrackedCues, axial_support, column_views, cue_support,
+    drop_outlying_matches, fit_stage2, render_settings, rs_timing, stage1_views, stage2_views, tracked_cues,
 };
 use crate::config::{Config, Stage2Config, ViewSelection};
 use crate::geometry::{Camera, ViewId};
@@ -319,10 +319,11 @@ pub(super) fn check_motion(
     Some(false)
 }
 
-/// Keeps the part of the kept motion along and about the optical axis only when the cues
-/// confirm it at `min_support` with the block jackknife's standard error
-/// ([`super::AxialSupport::confirms`]), else sets it to 0, and says in the log what they show.
-/// A motion with no such part, or too few cues or blocks to judge it, is kept as it is.
+/// Keeps each group of the kept motion's rates along and about the optical axis (one per
+/// segment of `piecewise_constant`, [`super::axial_groups`]) only when the cues confirm it at
+/// `min_support` with the block jackknife's standard error ([`super::AxialSupport::confirms`]),
+/// else sets it to 0, and says in the log what they show. A group that is 0, or that too few
+/// cues or blocks judge, is kept as it is.
 fn check_axial(
     mut fitted: MotionFit,
     model: &dyn MotionModel,
@@ -331,21 +332,43 @@ fn check_axial(
     min_support: f64,
     log: &mut RunLog,
 ) -> MotionFit {
-    let Some(support) = axial_support(camera, model, &fitted.parameters, cues) else { return fitted };
-    let confirmed = support.confirms(min_support);
-    if !confirmed {
-        axial_entries(model).into_iter().for_each(|i| fitted.parameters[i] = 0.0);
+    let judgements = axial_support(camera, model, &fitted.parameters, cues);
+    let sets = super::axial_groups(model).len();
+    let mut verdicts = Vec::new();
+    let mut changed = false;
+    for judgement in &judgements {
+        let set = if sets > 1 { format!("{}: ", judgement.group + 1) } else { String::new() };
+        let Some(support) = judgement.support else {
+            if sets > 1 {
+                verdicts.push(format!("{set}too few cues or blocks to judge, kept"));
+            }
+            continue;
+        };
+        let confirmed = support.confirms(min_support);
+        if !confirmed {
+            judgement.entries.iter().for_each(|&i| fitted.parameters[i] = 0.0);
+            changed = true;
+        }
+        let shown = format!("{set}{:.2} (± {:.2} over {} blocks of the image)", support.share, support.standard_error, support.blocks);
+        verdicts.push(match (confirmed, sets > 1) {
+            (true, false) => format!("{shown} of the roll and forward motion, the rest held; clearly over {min_support}: kept"),
+            (false, false) => format!("{shown} of the roll and forward motion, the rest held; not clearly over {min_support}: set to 0"),
+            (true, true) => format!("{shown}, clearly over {min_support}: kept"),
+            (false, true) => format!("{shown}, not clearly over {min_support}: set to 0"),
+        });
+    }
+    if verdicts.is_empty() {
+        return fitted;
     }
     log.push(format!(
-        "{AXIAL_CHECK_LINE}the measured cues of patches textured both ways bear out {:.2} (± {:.2} over {} blocks of the image) of the roll and forward motion, the rest held; {}",
-        support.share,
-        support.standard_error,
-        support.blocks,
-        if confirmed {
-            format!("clearly over {min_support}: kept")
+        "{AXIAL_CHECK_LINE}the measured cues of patches textured both ways bear out {}{}{}",
+        if sets > 1 {
+            format!("of each of the {sets} sets of roll and forward rates (a segment's each), the rest held, judged over the rows of blocks it moves: ")
         } else {
-            format!("not clearly over {min_support}: set to 0; estimate {}", estimate_line(model, &fitted.parameters))
-        }
+            String::new()
+        },
+        verdicts.join("; "),
+        if changed { format!("; estimate {}", estimate_line(model, &fitted.parameters)) } else { String::new() }
     ));
     fitted
 }
