@@ -8,7 +8,9 @@
 //! a fence or a cluster of branches shares one bias of the matching, and the check's standard
 //! error ([`super::CueSupport`]), which assumes independence, is then far too small. Here the
 //! error comes from a jackknife over blocks of the central view instead, so a part of the
-//! motion that one region of the image alone pins is not confirmed.
+//! motion that one region of the image alone pins is not confirmed. A model with a set of rates
+//! per segment of the read-out has each segment's judged on its own, over the blocks of the rows
+//! it moves.
 
 use super::cue_support::{WeighedComponent, weighed_components};
 use super::measured_cues::Cue;

@@ -363,7 +363,7 @@ fn check_axial(
     log.push(format!(
         "{AXIAL_CHECK_LINE}the measured cues of patches textured both ways bear out {}{}{}",
         if sets > 1 {
-            format!("of each of the {sets} sets of roll and forward rates (a segment's each), the rest held, judged over the rows of blocks it moves: ")
+            format!("of each of the {sets} sets of roll and forward rates (one per segment), the rest held, over the blocks of the rows it moves: ")
         } else {
             String::new()
         },
