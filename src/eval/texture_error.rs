@@ -81,7 +81,8 @@ fn texture_at(grey: &Raster, (u, v): (usize, usize), radius: usize) -> Texture {
 /// Splits the error of `estimate` against `truth` on the t = 0 points of `gt_depth` (every
 /// `stride`-th pixel, in the central view and the four corners, as
 /// [`super::image_motion_error`]) by the texture of `central`, the captured central view,
-/// around where it shows each point. `None` when no point is left or `central` is not the size of `gt_depth`.
+/// around where it shows each point. `None` when no point is left or `central` is not the size
+/// of `gt_depth`.
 pub fn texture_error(
     camera: &Camera,
     estimate: &MotionRecord,
