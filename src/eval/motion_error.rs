@@ -112,20 +112,17 @@ pub fn image_motion_error(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::geometry::ViewGrid;
 
+    /// A 64 x 48 px, 9 x 9 capture with a rolling shutter (also the texture split's tests').
+    pub(in crate::eval) fn camera() -> Camera {
+        Camera { grid: ViewGrid { rows: 9, cols: 9 }, width: 64, height: 48, f_px: 80.0, baseline_m: 0.02, focus_m: 3.0, line_time_s: 4e-4 }
+    }
+
     fn setup() -> (Camera, Raster) {
-        let cam = Camera {
-            grid: ViewGrid { rows: 9, cols: 9 },
-            width: 64,
-            height: 48,
-            f_px: 80.0,
-            baseline_m: 0.02,
-            focus_m: 3.0,
-            line_time_s: 4e-4,
-        };
+        let cam = camera();
         let depth = Raster { width: 64, height: 48, channels: 1, data: (0..64 * 48).map(|i| 2.0 + (i % 7) as f32 * 0.3).collect() };
         (cam, depth)
     }

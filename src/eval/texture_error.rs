@@ -128,11 +128,7 @@ pub fn texture_error(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::ViewGrid;
-
-    fn camera() -> Camera {
-        Camera { grid: ViewGrid { rows: 9, cols: 9 }, width: 64, height: 48, f_px: 80.0, baseline_m: 0.02, focus_m: 3.0, line_time_s: 4e-4 }
-    }
+    use crate::eval::motion_error::tests::camera;
 
     fn image(f: impl Fn(f64, f64) -> f64) -> Raster {
         let data = (0..64 * 48).map(|i| f((i % 64) as f64, (i / 64) as f64) as f32).collect();
