@@ -42,6 +42,17 @@ fn the_image_space_motion_error_takes_the_true_disparity_where_the_true_depth_is
     let squares = |group: &str| split[group]["share"].as_f64().unwrap() * split[group]["rms_error_px"].as_f64().map_or(0.0, |e| e * e);
     let added = (squares("one_way") + squares("both_ways") + squares("flat")).sqrt();
     assert!((added - from_depth).abs() < 2e-3, "{split} against {from_depth} px");
+    // The cues measured between the views are compared with the true motion's, whatever the
+    // result's motion: another estimate leaves them as they were.
+    let cues = metrics["motion"]["cues"].clone();
+    assert!(cues["cues"].as_u64().unwrap() > 100 && cues["truth_share"].is_f64() && cues["implied_error_px"].is_f64(), "{cues}");
+    std::fs::write(result.join("motion.toml"), truth.to_toml_string()).unwrap();
+    let (ok, _, stderr) = rslf(&["eval", "--scene", scene.to_str().unwrap(), "--result", result.to_str().unwrap()]);
+    assert!(ok, "{stderr}");
+    let again: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(result.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(again["motion"]["cues"], cues);
+    assert_eq!(again["motion"]["image"]["rms_error_px"].as_f64(), Some(0.0));
+    std::fs::write(result.join("motion.toml"), half.to_toml_string()).unwrap();
     std::fs::remove_file(scene.join("gt_depth_lowres.pfm")).unwrap();
     let (from_disparity, stdout) = image_error(&scene, &result);
     let from_disparity = from_disparity.unwrap_or_else(|| panic!("no image-space error without gt_depth_lowres.pfm: {stdout}"));

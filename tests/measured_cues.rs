@@ -11,6 +11,7 @@ mod common;
 use burn::tensor::{Device, Tensor, TensorData};
 use common::{hci, tempdir};
 use rslf::config::{MotionConfig, ViewSelection};
+use rslf::eval::{cue_bias, image_motion_error};
 use rslf::geometry::{TensorCamera, ViewId, readout_interval};
 use rslf::io::{GroundTruth, MotionRecord, Scene, read_pfm};
 use rslf::model::motion::{MotionRegistry, MotionSetup};
@@ -142,6 +143,15 @@ fn a_pan_shows_in_the_measured_cues_as_its_motion_predicts_them() {
         eprintln!("{kind}: measured cues {:.3} of the predicted ones", num / den);
         assert!((num / den - 1.0).abs() < 0.03, "{kind}: share {}", num / den);
     }
+    // `rslf eval`'s account of the same cues (the check's: textured both ways, its bounds):
+    // they bear out the true motion's, and fitted alone about the truth they leave a small
+    // share of its shift.
+    let depth = gt.depth.as_ref().unwrap();
+    let bias = cue_bias(&scene, &camera, &truth, gt.disparity.as_ref().unwrap(), depth, 4).expect("cues measured");
+    let shift = image_motion_error(&camera, &MotionRecord::zero(), &truth, depth, 4).unwrap().rms_error_px;
+    eprintln!("{bias:?}; true shift {shift:.3} px");
+    assert!((bias.truth_share.unwrap() - 1.0).abs() < 0.03 && bias.rms_miss_px < 0.06, "{bias:?}");
+    assert!(bias.implied_error_px.unwrap() < 0.1 * shift, "{bias:?} against a {shift} px shift");
 }
 
 #[test]

@@ -1,11 +1,13 @@
 //! Evaluation of a result folder against a scene's ground truth (`rslf eval`).
 
+mod cue_bias;
 mod metrics;
 mod motion_error;
 mod observability;
 mod report;
 mod texture_error;
 
+pub use cue_bias::{CueBias, cue_bias};
 pub use metrics::{
     BADPIX_THRESHOLDS, DepthMetrics, DisparityMetrics, HCI_BORDER_PX, ParameterError, depth_metrics, disparity_metrics, evaluation_region,
     motion_parameter_errors, psnr_db,
@@ -37,6 +39,11 @@ fn sized(path: &Path, r: Option<Raster>, w: usize, h: usize) -> IoResult<Option<
 fn depth_from_disparity(cam: &Camera, disp: &Raster) -> Raster {
     let data = disp.data.iter().map(|&d| cam.disparity_to_depth(d as f64) as f32).collect();
     Raster { data, ..disp.clone() }
+}
+
+fn disparity_from_depth(cam: &Camera, depth: &Raster) -> Raster {
+    let data = depth.data.iter().map(|&z| cam.depth_to_disparity(z as f64) as f32).collect();
+    Raster { data, ..depth.clone() }
 }
 
 /// Evaluates the result folder `result` against the ground truth of the scene folder `scene`.
@@ -126,6 +133,10 @@ pub fn evaluate(scene_dir: &Path, result: &Path) -> IoResult<EvalReport> {
                 image: points.and_then(|(cam, (z, _))| image_motion_error(cam, e, t, z, MOTION_POINT_STRIDE)),
                 observability: points.and_then(|(cam, (z, _))| observability(cam, t, z, OBSERVABILITY_POINT_STRIDE)),
                 texture: points.and_then(|(cam, (z, _))| texture_error(cam, e, t, z, scene.central(), MOTION_POINT_STRIDE)),
+                cues: points.and_then(|(cam, (z, _))| {
+                    let disparity = gt.disparity.clone().unwrap_or_else(|| disparity_from_depth(cam, z));
+                    cue_bias(&scene, cam, t, &disparity, z, MOTION_POINT_STRIDE)
+                }),
             })
         }
         (None, Some(_)) => {

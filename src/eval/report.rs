@@ -1,5 +1,6 @@
 //! The evaluation report: what `rslf eval` prints and writes as `metrics.json`.
 
+use super::cue_bias::CueBias;
 use super::metrics::{DepthMetrics, DisparityMetrics, ParameterError};
 use super::motion_error::ImageMotionError;
 use super::observability::Observability;
@@ -38,6 +39,10 @@ pub struct MotionReport {
     /// The image-space error split by the central view's texture around each point (where it
     /// runs one way, the component along it is what the views cannot show).
     pub texture: Option<TextureSplit>,
+    /// The cues stage 2's check uses, measured from the scene's views and the true disparity,
+    /// against those the true motion predicts, when the scene has a camera and ground-truth
+    /// depth.
+    pub cues: Option<CueBias>,
 }
 
 /// Everything `rslf eval` measured. Non-finite numbers are written as `null`.
@@ -141,6 +146,21 @@ impl fmt::Display for EvalReport {
                     error(&t.flat)
                 )?;
             }
+        }
+        if let Some(c) = self.motion.as_ref().and_then(|m| m.cues.as_ref()) {
+            let share = match (c.truth_share, c.truth_share_se) {
+                (Some(s), Some(e)) => format!("they bear out {} (± {}) of the true motion's, ", num(s, 3), num(e, 3)),
+                _ => String::new(),
+            };
+            let implied = c.implied_error_px.map_or(String::new(), |e| {
+                format!("; fitted alone about the truth (constant velocity, linearised) they would put the motion {} px off", num(e, 3))
+            });
+            writeln!(
+                f,
+                "motion     measured cues (the check's: {} in the corners, textured both ways, tracked from the true disparity): {share}RMS miss {} px{implied}",
+                c.cues,
+                num(c.rms_miss_px, 4)
+            )?;
         }
         for note in &self.notes {
             writeln!(f, "note: {note}")?;
