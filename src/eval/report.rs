@@ -146,21 +146,21 @@ impl fmt::Display for EvalReport {
                     error(&t.flat)
                 )?;
             }
-        }
-        if let Some(c) = self.motion.as_ref().and_then(|m| m.cues.as_ref()) {
-            let share = match (c.truth_share, c.truth_share_se) {
-                (Some(s), Some(e)) => format!("they bear out {} (± {}) of the true motion's, ", num(s, 3), num(e, 3)),
-                _ => String::new(),
-            };
-            let implied = c.implied_error_px.map_or(String::new(), |e| {
-                format!("; fitted alone about the truth (constant velocity, linearised) they would put the motion {} px off", num(e, 3))
-            });
-            writeln!(
-                f,
-                "motion     measured cues (the check's: {} in the corners, textured both ways, tracked from the true disparity): {share}RMS miss {} px{implied}",
-                c.cues,
-                num(c.rms_miss_px, 4)
-            )?;
+            if let Some(c) = &m.cues {
+                let share = match (c.truth_share, c.truth_share_se) {
+                    (Some(s), Some(e)) => format!("they bear out {} (± {}) of the true motion's, ", num(s, 3), num(e, 3)),
+                    _ => String::new(),
+                };
+                let implied = c.implied_error_px.map_or(String::new(), |e| {
+                    format!("; fitted alone about the truth (constant velocity, linearised) they would put the motion {} px off", num(e, 3))
+                });
+                writeln!(
+                    f,
+                    "motion     measured cues (the check's: {} in the corners, textured both ways, tracked from the true disparity): {share}RMS miss {} px{implied}",
+                    c.cues,
+                    num(c.rms_miss_px, 4)
+                )?;
+            }
         }
         for note in &self.notes {
             writeln!(f, "note: {note}")?;
