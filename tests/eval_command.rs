@@ -45,7 +45,10 @@ fn the_image_space_motion_error_takes_the_true_disparity_where_the_true_depth_is
     // The cues measured between the views are compared with the true motion's, whatever the
     // result's motion: another estimate leaves them as they were.
     let cues = metrics["motion"]["cues"].clone();
-    assert!(cues["cues"].as_u64().unwrap() > 100 && cues["truth_share"].is_f64() && cues["implied_error_px"].is_f64(), "{cues}");
+    for group in ["both_ways", "all"] {
+        let g = &cues[group];
+        assert!(g["cues"].as_u64().unwrap() > 100 && g["truth_share"].is_f64() && g["implied_error_px"].is_f64(), "{cues}");
+    }
     std::fs::write(result.join("motion.toml"), truth.to_toml_string()).unwrap();
     let (ok, _, stderr) = rslf(&["eval", "--scene", scene.to_str().unwrap(), "--result", result.to_str().unwrap()]);
     assert!(ok, "{stderr}");

@@ -150,8 +150,12 @@ fn a_pan_shows_in_the_measured_cues_as_its_motion_predicts_them() {
     let bias = cue_bias(&scene, &camera, &truth, gt.disparity.as_ref().unwrap(), depth, 4).expect("cues measured");
     let shift = image_motion_error(&camera, &MotionRecord::zero(), &truth, depth, 4).unwrap().rms_error_px;
     eprintln!("{bias:?}; true shift {shift:.3} px");
-    assert!((bias.truth_share.unwrap() - 1.0).abs() < 0.03 && bias.rms_miss_px < 0.06, "{bias:?}");
-    assert!(bias.implied_error_px.unwrap() < 0.1 * shift, "{bias:?} against a {shift} px shift");
+    let (both, one, all) = (bias.both_ways.unwrap(), bias.one_way.unwrap(), bias.all.unwrap());
+    assert_eq!(all.cues, both.cues + one.cues);
+    for group in [both, one, all] {
+        assert!((group.truth_share.unwrap() - 1.0).abs() < 0.03 && group.rms_miss_px < 0.06, "{bias:?}");
+    }
+    assert!(both.implied_error_px.unwrap() < 0.1 * shift, "{bias:?} against a {shift} px shift");
 }
 
 #[test]

@@ -7,7 +7,7 @@ mod observability;
 mod report;
 mod texture_error;
 
-pub use cue_bias::{CueBias, cue_bias};
+pub use cue_bias::{CueBias, CueGroup, cue_bias};
 pub use metrics::{
     BADPIX_THRESHOLDS, DepthMetrics, DisparityMetrics, HCI_BORDER_PX, ParameterError, depth_metrics, disparity_metrics, evaluation_region,
     motion_parameter_errors, psnr_db,

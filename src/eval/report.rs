@@ -1,6 +1,6 @@
 //! The evaluation report: what `rslf eval` prints and writes as `metrics.json`.
 
-use super::cue_bias::CueBias;
+use super::cue_bias::{CueBias, CueGroup};
 use super::metrics::{DepthMetrics, DisparityMetrics, ParameterError};
 use super::motion_error::ImageMotionError;
 use super::observability::Observability;
@@ -147,18 +147,23 @@ impl fmt::Display for EvalReport {
                 )?;
             }
             if let Some(c) = &m.cues {
-                let share = match (c.truth_share, c.truth_share_se) {
-                    (Some(s), Some(e)) => format!("they bear out {} (± {}) of the true motion's, ", num(s, 3), num(e, 3)),
-                    _ => String::new(),
+                let group = |name: &str, g: &CueGroup| {
+                    let share = match (g.truth_share, g.truth_share_se) {
+                        (Some(s), Some(e)) => format!(", bear out {} (± {}) of the true motion's", num(s, 3), num(e, 3)),
+                        _ => String::new(),
+                    };
+                    let alone = g.implied_error_px.map_or(String::new(), |e| format!(", alone {} px off", num(e, 3)));
+                    format!("{name} {}{share}, RMS miss {} px{alone}", g.cues, num(g.rms_miss_px, 4))
                 };
-                let implied = c.implied_error_px.map_or(String::new(), |e| {
-                    format!("; fitted alone about the truth (constant velocity, linearised) they would put the motion {} px off", num(e, 3))
-                });
+                let groups: Vec<String> =
+                    [("textured both ways (the check's)", &c.both_ways), ("edges and stripes", &c.one_way), ("all (the fit's)", &c.all)]
+                        .iter()
+                        .filter_map(|(name, g)| Some(group(name, g.as_ref()?)))
+                        .collect();
                 writeln!(
                     f,
-                    "motion     measured cues (the check's: {} in the corners, textured both ways, tracked from the true disparity): {share}RMS miss {} px{implied}",
-                    c.cues,
-                    num(c.rms_miss_px, 4)
+                    "motion     measured cues in the corners, tracked from the true disparity, against the true motion's (alone: a least-squares fit of them about a constant-velocity truth, image-space): {}",
+                    groups.join("; ")
                 )?;
             }
         }
