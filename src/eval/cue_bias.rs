@@ -67,6 +67,13 @@ struct Component {
     predicted: f64,
 }
 
+/// The parameters of a constant-velocity truth, and each compared cue's derivatives in them
+/// (px per unit, x and y).
+struct Derivatives {
+    truth: [f64; 6],
+    per_cue: Vec<[(f64, f64); 6]>,
+}
+
 /// The parameters of a constant-velocity record, ω then v.
 fn parameters(record: &MotionRecord) -> Option<[f64; 6]> {
     match record {
@@ -133,7 +140,7 @@ pub fn cue_bias(
                 }
             })
         };
-        (p0, compared.par_iter().map(|(c, _)| of(c)).collect::<Vec<_>>())
+        Derivatives { truth: p0, per_cue: compared.par_iter().map(|(c, _)| of(c)).collect() }
     });
     let group = |two_way: Option<bool>| {
         let components = components(two_way);
@@ -144,14 +151,13 @@ pub fn cue_bias(
 }
 
 /// The figures of one group of `cues` cues, given as their measured `components`; with the
-/// parameters of a constant-velocity truth and every compared cue's derivatives in them, the
-/// error of the motion they alone would give.
+/// `derivatives` of a constant-velocity truth, the error of the motion they alone would give.
 fn cue_group(
     camera: &Camera,
     truth: &MotionRecord,
     components: &[Component],
     cues: usize,
-    derivatives: Option<&([f64; 6], Vec<[(f64, f64); 6]>)>,
+    derivatives: Option<&Derivatives>,
     gt_depth: &Raster,
     stride: usize,
 ) -> CueGroup {
@@ -162,11 +168,11 @@ fn cue_group(
     let scatter = (kept.iter().map(|c| c.miss * c.miss).sum::<f64>() / kept.len().max(1) as f64).sqrt();
     let (truth_share, truth_share_se) = if den > 1e-12 { (Some(1.0 + num / den), Some(scatter / den.sqrt())) } else { (None, None) };
     // The least-squares step the kept components ask for, each along its axis.
-    let implied_error_px = derivatives.and_then(|(p0, derivatives)| {
+    let implied_error_px = derivatives.and_then(|Derivatives { truth: p0, per_cue }| {
         let (mut normal, mut rhs) = (SMatrix::<f64, 6, 6>::zeros(), SVector::<f64, 6>::zeros());
         for c in &kept {
             let row = SVector::<f64, 6>::from_fn(|k, _| {
-                let d = derivatives[c.cue][k];
+                let d = per_cue[c.cue][k];
                 c.axis.0 * d.0 + c.axis.1 * d.1
             });
             normal += row * row.transpose();
