@@ -257,6 +257,12 @@ pub struct Stage2Config {
     /// (0 = left where the Adam steps put them): what the views cannot tell apart is taken to be
     /// still. One more Hessian (a gradient per motion parameter).
     pub newton_rest_tolerance: f64,
+    /// With the measured-cue term in the fit, after the Newton steps (and the move to rest) the
+    /// directions they hold are set where the cue term alone is least, the rest of the motion
+    /// kept: along them the photometric objective's minimum is off the truth (freed, they carry
+    /// the fit away from it), while the cues', measured straight between the views, is near it.
+    /// One more Hessian, then Newton steps on the cue term alone.
+    pub held_by_cues: bool,
     /// The least support (0..1) the measured cues must give the part of the kept motion along
     /// and about the optical axis (forward translation, roll: the least observed rates), the
     /// rest of the motion held, with a standard error from a jackknife over blocks of the image
@@ -292,6 +298,7 @@ impl Default for Stage2Config {
             initial_motion: None,
             newton_iterations: 5,
             newton_rest_tolerance: 1e-3,
+            held_by_cues: false,
             min_axial_support: 0.5,
         }
     }

@@ -14,7 +14,7 @@ mod schedule;
 mod stage;
 
 pub use mean_loss::MeanLoss;
-pub use newton::{NewtonReport, NewtonSettings, RestReport, newton_minimise};
+pub use newton::{NewtonReport, NewtonSettings, RestReport, held_directions, newton_minimise, newton_within};
 pub use plan::{GroupPlan, Optimiser, Plan};
 pub use schedule::Schedule;
 pub use stage::{Objective, Stage, StepReport, optimise};

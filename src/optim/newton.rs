@@ -159,6 +159,51 @@ pub fn newton_minimise(x0: &[f64], settings: &NewtonSettings, mut eval: impl FnM
     (x.as_slice().to_vec(), report)
 }
 
+/// The directions [`newton_minimise`] would hold at `x`: the unit eigenvectors of the Hessian of
+/// `eval` there whose curvature is under `min_curvature_ratio` of the steepest's (none where that
+/// ratio is 0 or less). One gradient at `x` and one per parameter.
+pub fn held_directions(
+    x: &[f64],
+    fd_step: f64,
+    min_curvature_ratio: f64,
+    mut eval: impl FnMut(&[f64]) -> (f64, Vec<f64>),
+) -> Vec<Vec<f64>> {
+    if min_curvature_ratio <= 0.0 || x.is_empty() {
+        return Vec::new();
+    }
+    let at = DVector::from_column_slice(x);
+    let (_, g) = eval(x);
+    let eigen = hessian_at(&at, &DVector::from_vec(g), fd_step, &mut eval).symmetric_eigen();
+    let floor = min_curvature_ratio * eigen.eigenvalues.max();
+    (0..x.len()).filter(|&k| eigen.eigenvalues[k] < floor).map(|k| eigen.eigenvectors.column(k).iter().copied().collect()).collect()
+}
+
+/// Minimises `eval` over the points `x0 + Σ a_k directions[k]` alone, by at most
+/// `settings.iterations` damped Newton steps on the coefficients `a` from 0 (none of them held,
+/// none set to rest): another objective's say along the directions one objective cannot tell
+/// apart, the rest of `x0` kept. Returns the point reached and the report (its objective
+/// values are `eval`'s).
+pub fn newton_within(
+    x0: &[f64],
+    directions: &[Vec<f64>],
+    settings: &NewtonSettings,
+    mut eval: impl FnMut(&[f64]) -> (f64, Vec<f64>),
+) -> (Vec<f64>, NewtonReport) {
+    let point = |a: &[f64]| -> Vec<f64> {
+        let mut x = x0.to_vec();
+        for (d, &t) in directions.iter().zip(a) {
+            x.iter_mut().zip(d).for_each(|(xi, di)| *xi += t * di);
+        }
+        x
+    };
+    let within = NewtonSettings { min_curvature_ratio: 0.0, rest_tolerance: 0.0, ..*settings };
+    let (a, report) = newton_minimise(&vec![0.0; directions.len()], &within, |a| {
+        let (f, g) = eval(&point(a));
+        (f, directions.iter().map(|d| d.iter().zip(&g).map(|(di, gi)| di * gi).sum()).collect())
+    });
+    (point(&a), report)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,6 +283,27 @@ mod tests {
         let rested = report.rest.expect("tried");
         assert!(!rested.taken && (rested.after - rested.before - 5e-3).abs() < 1e-4, "{report:?}");
         assert!((offsets(&x).1 - q0).abs() < 1e-9 && report.end == rested.before, "{x:?} {report:?}");
+    }
+
+    #[test]
+    fn the_held_direction_is_set_by_a_second_objective_and_the_steep_one_is_kept() {
+        // The valley (minimum (1, 2), flat along (1, -1)) holds its flat direction under a floor
+        // of 10^-3. A second objective, least at (4, 1), decides that direction alone: from a
+        // point off the valley floor, the step moves along (1, -1) only, to where the second
+        // objective is least along that line, not to its minimum.
+        let held = held_directions(&[1.0, 2.0], 1e-4, 1e-3, valley);
+        assert_eq!(held.len(), 1);
+        let d = &held[0];
+        assert!((d[0] + d[1]).abs() < 1e-6 && (d[0].abs() - 0.5f64.sqrt()).abs() < 1e-6, "{held:?}");
+        let second = |x: &[f64]| ((x[0] - 4.0).powi(2) + (x[1] - 1.0).powi(2), vec![2.0 * (x[0] - 4.0), 2.0 * (x[1] - 1.0)]);
+        let start = [1.5, 2.5];
+        let (x, report) = newton_within(&start, &held, &SETTINGS, second);
+        // Along (1, -1) from (1.5, 2.5), the point nearest (4, 1) is (3.5, 0.5): the valley's
+        // steep coordinate x + y stays 4.
+        assert!((x[0] - 3.5).abs() < 1e-6 && (x[1] - 0.5).abs() < 1e-6, "{x:?} {report:?}");
+        assert!(report.end < report.start && report.taken >= 1, "{report:?}");
+        // No floor, nothing held.
+        assert!(held_directions(&[1.0, 2.0], 1e-4, 0.0, valley).is_empty());
     }
 
     #[test]

@@ -165,6 +165,7 @@ fn fit_and_check(
             min_curvature_ratio: NEWTON_MIN_CURVATURE_RATIO,
             rest_tolerance: s.newton_rest_tolerance,
         },
+        held_by_cues: s.held_by_cues,
     };
     // One phase of the fit, with its progress bar and its line in the log. The Newton steps go to
     // the last (`last`), whose motion is kept: the second when the check may confirm the motion
@@ -185,7 +186,7 @@ fn fit_and_check(
         let bands = row_bands(0..scene.height(), s.band_height).len();
         let stage2_ends = curve_ends(&fitted.curve, bands.div_ceil(s.bands_per_step.clamp(1, bands.max(1))));
         log.push(format!(
-            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}, {:.1} s; estimate {}",
+            "stage 2 {what}: `{}` motion, {} Adam steps, {} bands of {} rows in each of {} views per step ({:?} timing), {}{}{}, loss ({}) {:.4} -> {:.4} over the first and the last round of bands{}{}, {:.1} s; estimate {}",
             model.name(),
             s.iterations,
             s.bands_per_step,
@@ -217,6 +218,18 @@ fn fit_and_check(
                     100.0 * (rest.after - rest.before) / rest.before.abs().max(f64::MIN_POSITIVE),
                     100.0 * s.newton_rest_tolerance
                 ))
+            )),
+            fitted.held_by_cues.map_or(String::new(), |h| format!(
+                ", then the {} direction{} they hold {} where the cue term alone is least ({:.3} scaled units away, cue term {:.5e} -> {:.5e}, {:.1} times what the cues' noise would give, {} {} a direction)",
+                h.directions,
+                if h.directions == 1 { "" } else { "s" },
+                if h.taken { "set" } else { "not set" },
+                h.distance,
+                h.before,
+                h.after,
+                h.gain,
+                if h.taken { "at least" } else { "under" },
+                super::HELD_BY_CUES_MIN_GAIN
             )),
             start.elapsed().as_secs_f64(),
             estimate_line(model, &fitted.parameters)
