@@ -260,8 +260,9 @@ pub struct Stage2Config {
     /// With the measured-cue term in the fit, after the Newton steps (and the move to rest) the
     /// directions they hold are set where the cue term alone is least, the rest of the motion
     /// kept: along them the photometric objective's minimum is off the truth (freed, they carry
-    /// the fit away from it), while the cues', measured straight between the views, is near it.
-    /// One more Hessian, then Newton steps on the cue term alone.
+    /// the fit away from it), while the cues', measured straight between the views, can lie
+    /// near it. One more Hessian, then Newton steps on the cue term alone. The move is kept only
+    /// where the cues bear it out at `min_axial_support`, judged over blocks of the image.
     pub held_by_cues: bool,
     /// The least support (0..1) the measured cues must give the part of the kept motion along
     /// and about the optical axis (forward translation, roll: the least observed rates), the

@@ -25,7 +25,7 @@ mod view_tracking;
 mod visibility;
 
 pub use aperture::aperture_weights;
-pub use axial_check::{AxialJudgement, AxialSupport, axial_groups, axial_support};
+pub use axial_check::{AxialJudgement, AxialSupport, axial_groups, axial_support, part_support};
 pub use cue_support::{CueSupport, cue_support};
 pub use cue_term::{CueTerm, residual_weights};
 pub use gaussian_init::{frequency_map, sample_gaussians};
@@ -40,7 +40,7 @@ pub use run_log::RunLog;
 pub use spline_image::SplineImage;
 pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
 pub use stage2::{AXIAL_CHECK_LINE, CHECK_LINE, REFIT_CHECK_LINE};
-pub use stage2_fit::{HELD_BY_CUES_MIN_GAIN, HeldByCues, MotionFit, Stage2Context, Stage2Fit, fit_stage2, motion_scales, pose_table};
+pub use stage2_fit::{HeldByCues, MotionFit, Stage2Context, Stage2Fit, fit_stage2, motion_scales, pose_table};
 pub use view_tracking::{Track, TrackSettings, textured_points, track};
 pub use visibility::explained_mask;
 

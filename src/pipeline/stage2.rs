@@ -41,6 +41,9 @@ pub const AXIAL_CHECK_LINE: &str = "stage 2 check of the roll and forward motion
 /// How the line with the verdict on the fit with the cues, after a check that did not confirm
 /// the motion, begins.
 pub const REFIT_CHECK_LINE: &str = "stage 2 check of the fit with the measured cues: ";
+/// How the line with the verdict on the move of the held directions to the cue term's least
+/// (`[stage2] held_by_cues`) begins.
+pub const HELD_CHECK_LINE: &str = "stage 2 check of the held directions' move: ";
 
 /// Stage 2: the motion, fitted against the off-row views and checked against the cues measured
 /// between them. With the check on, the measured-cue term (`cue_weight`) joins only after it:
@@ -96,11 +99,33 @@ pub(super) fn run(
         }
         cues
     });
-    let fitted = fit_and_check(config, ctx, gaussians, start_values, cues.as_deref(), log, curves);
+    let mut fitted = fit_and_check(config, ctx, gaussians, start_values, cues.as_deref(), log, curves);
+    if let Some(cues) = &cues {
+        check_held_move(&mut fitted, model, camera, cues, s.min_axial_support, log);
+    }
     match cues {
         Some(cues) if check_axial_part => check_axial(fitted, model, camera, &two_way(&cues), s.min_axial_support, log),
         _ => fitted,
     }
+}
+
+/// Keeps the move of the held directions to the cue term's least ([`super::HeldByCues`]) only
+/// where the cues confirm it at `min_support` with the block jackknife's standard error
+/// ([`super::part_support`]: every cue the term holds, judged over 4 x 4 blocks of the view),
+/// else puts the motion back where the Newton steps left it, and says so in the log. A move the
+/// blocks cannot judge goes back too.
+fn check_held_move(fitted: &mut MotionFit, model: &dyn MotionModel, camera: &Camera, cues: &[Cue], min_support: f64, log: &mut RunLog) {
+    let Some(held) = fitted.held_by_cues.as_ref() else { return };
+    let support = super::part_support(camera, &model.record(&held.unmoved), &model.record(&fitted.parameters), cues);
+    let confirmed = support.is_some_and(|s| s.confirms(min_support));
+    let shown = support.map_or("no judgement (too few cues or blocks)".to_string(), |s| {
+        format!("{:.2} (± {:.2} over {} blocks of the image)", s.share, s.standard_error, s.blocks)
+    });
+    let verdict = if confirmed { format!("clearly over {min_support}: kept") } else { format!("not clearly over {min_support}: put back") };
+    if !confirmed {
+        fitted.parameters = held.unmoved.clone();
+    }
+    log.push(format!("{HELD_CHECK_LINE}the measured cues bear out {shown} of the move of the held directions; {verdict}"));
 }
 
 /// The patches textured both ways alone: the cues of edges and stripes carry biases of a few
@@ -219,17 +244,13 @@ fn fit_and_check(
                     100.0 * s.newton_rest_tolerance
                 ))
             )),
-            fitted.held_by_cues.map_or(String::new(), |h| format!(
-                ", then the {} direction{} they hold {} where the cue term alone is least ({:.3} scaled units away, cue term {:.5e} -> {:.5e}, {:.1} times what the cues' noise would give, {} {} a direction)",
+            fitted.held_by_cues.as_ref().map_or(String::new(), |h| format!(
+                ", then the {} direction{} they hold set where the cue term alone is least ({:.3} scaled units away, cue term {:.5e} -> {:.5e})",
                 h.directions,
                 if h.directions == 1 { "" } else { "s" },
-                if h.taken { "set" } else { "not set" },
                 h.distance,
                 h.before,
-                h.after,
-                h.gain,
-                if h.taken { "at least" } else { "under" },
-                super::HELD_BY_CUES_MIN_GAIN
+                h.after
             )),
             start.elapsed().as_secs_f64(),
             estimate_line(model, &fitted.parameters)

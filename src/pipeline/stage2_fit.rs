@@ -62,7 +62,7 @@ pub struct Stage2Fit {
 }
 
 /// The directions the Newton steps held, set where the measured-cue term alone is least.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct HeldByCues {
     /// How many directions were held.
     pub directions: usize,
@@ -72,21 +72,9 @@ pub struct HeldByCues {
     pub before: f64,
     /// See `before`.
     pub after: f64,
-    /// The cue term's fall, times the number of cues, over its value after: about the number of
-    /// directions where the cues show nothing along them (the least-squares fall of pure
-    /// noise), far more where they do.
-    pub gain: f64,
-    /// Whether the move was kept: `gain` at least [`HELD_BY_CUES_MIN_GAIN`] per direction.
-    pub taken: bool,
+    /// The motion before the move (SI), for a check of the move against the cues.
+    pub unmoved: Vec<f64>,
 }
-
-/// The least fall of the cue term, per held direction and in units of what the cues' noise
-/// alone would give ([`HeldByCues::gain`]), for the move along the held directions to be kept.
-/// On the 512 px suite the `objects` fast scenes gain 35 and 204 (one direction) and move to
-/// within the targets; `vegetation_slow2`, whose cues lie on one fence and run 15 % large, gains
-/// 1.0 over two directions, and its move would take it from 0.170 to 0.554 px
-/// (docs/results.md).
-pub const HELD_BY_CUES_MIN_GAIN: f64 = 10.0;
 
 /// Newton steps on the cue term alone along the held directions ([`Stage2Fit::held_by_cues`]):
 /// it is nearly quadratic there, and 4-5 steps settled it on the `objects` scenes at 512 px.
@@ -416,13 +404,9 @@ pub fn fit_stage2(
                 let settings = NewtonSettings { iterations: HELD_BY_CUES_ITERATIONS, ..fit.newton };
                 let (moved, cue_report) = newton_within(&end, &held, &settings, cue_term);
                 let distance = moved.iter().zip(&end).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
-                let (before, after) = (cue_report.start, cue_report.end);
-                let gain = cues.len as f64 * (before - after) / after.max(f64::MIN_POSITIVE);
-                let taken = gain >= HELD_BY_CUES_MIN_GAIN * held.len() as f64;
-                by_cues = Some(HeldByCues { directions: held.len(), distance, before, after, gain, taken });
-                if taken {
-                    end = moved;
-                }
+                let unmoved = end.iter().zip(&scales).map(|(x, s)| x * s).collect();
+                by_cues = Some(HeldByCues { directions: held.len(), distance, before: cue_report.start, after: cue_report.end, unmoved });
+                end = moved;
             }
         }
         (end.iter().zip(&scales).map(|(x, s)| x * s).collect(), Some(report), by_cues)
