@@ -334,3 +334,28 @@ fn with_the_measured_cues_the_newton_steps_leave_the_motion_prior_out() {
     let (weak, strong) = (run("weak_prior", 0.0, 3e-5), run("strong_prior", 0.0, 1.0));
     assert!(weak != strong, "{weak:?}");
 }
+
+#[test]
+fn the_held_directions_set_by_the_cue_term_are_judged_and_a_move_put_back_restores_the_newton_motion() {
+    // The same short fit with and without `held_by_cues`: the first logs the move along the
+    // held directions and its judgement; a move put back leaves exactly the motion of the run
+    // without it, and one kept differs from it.
+    let root = common::tempdir();
+    generate(root.path());
+    let run = |name: &str, held: bool| {
+        let extra = format!("iterations = 10\nmin_cue_support = 0.0\ncue_weight = 1.0\nnewton_iterations = 3\nheld_by_cues = {held}");
+        let stdout = train(root.path(), &config(root.path(), name, "constant_velocity", &extra), name);
+        (stdout, motion_of(root.path(), name))
+    };
+    let (plain_log, plain) = run("without_held", false);
+    let (log, moved) = run("held_by_cues", true);
+    assert!(!plain_log.contains("set where the cue term alone is least"), "{plain_log}");
+    assert!(log.contains("set where the cue term alone is least"), "{log}");
+    let verdict = log.lines().find(|l| l.starts_with("stage 2 check of the held directions' move: ")).unwrap_or_else(|| panic!("{log}"));
+    eprintln!("{verdict}");
+    if verdict.ends_with("put back") {
+        assert_eq!(moved, plain, "{verdict}");
+    } else {
+        assert!(verdict.ends_with("kept") && moved != plain, "{verdict}: {moved:?}");
+    }
+}

@@ -113,9 +113,9 @@ pub(super) fn run(
 /// where the cues confirm it at `min_support` with the block jackknife's standard error
 /// ([`super::part_support`]: every cue the term holds, judged over 4 x 4 blocks of the view),
 /// else puts the motion back where the Newton steps left it, and says so in the log. A move the
-/// blocks cannot judge goes back too.
+/// blocks cannot judge goes back too; with `min_support` 0 (no block checks) it is kept as it is.
 fn check_held_move(fitted: &mut MotionFit, model: &dyn MotionModel, camera: &Camera, cues: &[Cue], min_support: f64, log: &mut RunLog) {
-    let Some(held) = fitted.held_by_cues.as_ref() else { return };
+    let Some(held) = fitted.held_by_cues.as_ref().filter(|_| min_support > 0.0) else { return };
     let support = super::part_support(camera, &model.record(&held.unmoved), &model.record(&fitted.parameters), cues);
     let confirmed = support.is_some_and(|s| s.confirms(min_support));
     let shown = support.map_or("no judgement (too few cues or blocks)".to_string(), |s| {
