@@ -104,11 +104,14 @@ pub fn cue_bias(
     if compared.is_empty() {
         return None;
     }
+    // Whether a cue belongs to a group: textured both ways (`Some(true)`), one way
+    // (`Some(false)`), or any (`None`).
+    let in_group = |c: &Cue, two_way: Option<bool>| two_way.is_none_or(|t| c.across.is_none() == t);
     let components = |two_way: Option<bool>| -> Vec<Component> {
         compared
             .iter()
             .enumerate()
-            .filter(|(_, (c, _))| two_way.is_none_or(|t| c.across.is_none() == t))
+            .filter(|(_, (c, _))| in_group(c, two_way))
             .flat_map(|(i, (c, p))| {
                 c.measured_axes().into_iter().map(move |(_, (ax, ay))| Component {
                     cue: i,
@@ -144,7 +147,7 @@ pub fn cue_bias(
     });
     let group = |two_way: Option<bool>| {
         let components = components(two_way);
-        let cues = compared.iter().filter(|(c, _)| two_way.is_none_or(|t| c.across.is_none() == t)).count();
+        let cues = compared.iter().filter(|(c, _)| in_group(c, two_way)).count();
         (cues > 0).then(|| cue_group(camera, truth, &components, cues, derivatives.as_ref(), gt_depth, stride))
     };
     Some(CueBias { both_ways: group(Some(true)), one_way: group(Some(false)), all: group(None) })
