@@ -262,8 +262,9 @@ pub struct Stage2Config {
     /// kept: along them the photometric objective's minimum is off the truth (freed, they carry
     /// the fit away from it), while the cues', measured straight between the views, can lie
     /// near it. One more Hessian, then Newton steps on the cue term alone. The move is kept only
-    /// where the cues bear it out at `min_axial_support`, judged over blocks of the image (0:
-    /// kept unjudged).
+    /// where the views and the cues both ask for it: the photometric terms must not rise with
+    /// it, and the cues must bear it out at `min_axial_support`, judged over blocks of the image
+    /// (0: the views alone judge it).
     pub held_by_cues: bool,
     /// The least support (0..1) the measured cues must give the part of the kept motion along
     /// and about the optical axis (forward translation, roll: the least observed rates), the

@@ -110,22 +110,33 @@ pub(super) fn run(
 }
 
 /// Keeps the move of the held directions to the cue term's least ([`super::HeldByCues`]) only
-/// where the cues confirm it at `min_support` with the block jackknife's standard error
-/// ([`super::part_support`]: every cue the term holds, judged over 4 x 4 blocks of the view),
-/// else puts the motion back where the Newton steps left it, and says so in the log. A move the
-/// blocks cannot judge goes back too; with `min_support` 0 (no block checks) it is kept as it is.
+/// where the two kinds of evidence both ask for it: the views, whose photometric terms must not
+/// rise with it ([`super::HeldByCues::photometric_rise`]), and the cues, which must bear out
+/// `min_support` of it by two standard errors of the block jackknife ([`super::part_support`]:
+/// every cue the term holds, judged over 4 x 4 blocks of the view; with `min_support` 0 they
+/// are not asked). Otherwise the motion goes back where the Newton steps left it, as it does
+/// where the blocks cannot judge the move; the log says which.
 fn check_held_move(fitted: &mut MotionFit, model: &dyn MotionModel, camera: &Camera, cues: &[Cue], min_support: f64, log: &mut RunLog) {
-    let Some(held) = fitted.held_by_cues.as_ref().filter(|_| min_support > 0.0) else { return };
-    let support = super::part_support(camera, &model.record(&held.unmoved), &model.record(&fitted.parameters), cues);
-    let confirmed = support.is_some_and(|s| s.confirms(min_support));
-    let shown = support.map_or("no judgement (too few cues or blocks)".to_string(), |s| {
-        format!("{:.2} (± {:.2} over {} blocks of the image)", s.share, s.standard_error, s.blocks)
-    });
-    let verdict = if confirmed { format!("clearly over {min_support}: kept") } else { format!("not clearly over {min_support}: put back") };
-    if !confirmed {
+    let Some(held) = fitted.held_by_cues.as_ref() else { return };
+    let rise = held.photometric_rise();
+    let views = format!("the views' photometric terms {} by {:.4} % with it", if rise > 0.0 { "rise" } else { "fall" }, 100.0 * rise.abs());
+    let (cues_confirm, cues_said) = if min_support > 0.0 {
+        let support = super::part_support(camera, &model.record(&held.unmoved), &model.record(&fitted.parameters), cues);
+        let shown = support.map_or("no judgement (too few cues or blocks)".to_string(), |s| {
+            format!("{:.2} (± {:.2} over {} blocks of the image)", s.share, s.standard_error, s.blocks)
+        });
+        let confirmed = support.is_some_and(|s| s.confirms(min_support));
+        let clearly = if confirmed { "clearly over" } else { "not clearly over" };
+        (confirmed, format!(", and the measured cues bear out {shown} of it, {clearly} {min_support}"))
+    } else {
+        (true, String::new())
+    };
+    let kept = rise <= 0.0 && cues_confirm;
+    if !kept {
         fitted.parameters = held.unmoved.clone();
     }
-    log.push(format!("{HELD_CHECK_LINE}the measured cues bear out {shown} of the move of the held directions; {verdict}"));
+    let verdict = if kept { "kept" } else { "put back" };
+    log.push(format!("{HELD_CHECK_LINE}{views}{cues_said}: {verdict}"));
 }
 
 /// The patches textured both ways alone: the cues of edges and stripes carry biases of a few
@@ -245,12 +256,13 @@ fn fit_and_check(
                 ))
             )),
             fitted.held_by_cues.as_ref().map_or(String::new(), |h| format!(
-                ", then the {} direction{} they hold set where the cue term alone is least ({:.3} scaled units away, cue term {:.5e} -> {:.5e})",
+                ", then the {} direction{} they hold set where the cue term alone is least ({:.3} scaled units away, cue term {:.5e} -> {:.5e}, objective {:+.4} %)",
                 h.directions,
                 if h.directions == 1 { "" } else { "s" },
                 h.distance,
                 h.before,
-                h.after
+                h.after,
+                100.0 * (h.objective_after - h.objective_before) / h.objective_before.abs().max(f64::MIN_POSITIVE)
             )),
             start.elapsed().as_secs_f64(),
             estimate_line(model, &fitted.parameters)

@@ -72,8 +72,23 @@ pub struct HeldByCues {
     pub before: f64,
     /// See `before`.
     pub after: f64,
+    /// The whole objective of the Newton steps (the photometric terms and the cue term) before
+    /// and after.
+    pub objective_before: f64,
+    /// See `objective_before`.
+    pub objective_after: f64,
     /// The motion before the move (SI), for a check of the move against the cues.
     pub unmoved: Vec<f64>,
+}
+
+impl HeldByCues {
+    /// How much the photometric terms (the whole objective less the cue term) rose with the
+    /// move, as a share of the whole objective before it: over 0, the views disagree with the
+    /// move the cues ask for.
+    pub fn photometric_rise(&self) -> f64 {
+        let photometric = (self.objective_after - self.after) - (self.objective_before - self.before);
+        photometric / self.objective_before.abs().max(f64::MIN_POSITIVE)
+    }
 }
 
 /// Newton steps on the cue term alone along the held directions ([`Stage2Fit::held_by_cues`]):
@@ -389,7 +404,8 @@ pub fn fit_stage2(
         let mut eval = eval;
         let (mut end, report) = newton_minimise(&start, &fit.newton, &mut eval);
         // The directions the steps hold, where the photometric objective's minimum lies off the
-        // truth, set where the cue term alone is least (docs/results.md).
+        // truth, set where the cue term alone is least (docs/results.md), and the whole
+        // objective there, by which the run judges whether the views ask for that move too.
         let mut by_cues = None;
         if let Some(cues) = cues.filter(|_| fit.held_by_cues) {
             let held = held_directions(&end, fit.newton.fd_step, fit.newton.min_curvature_ratio, &mut eval);
@@ -405,7 +421,16 @@ pub fn fit_stage2(
                 let (moved, cue_report) = newton_within(&end, &held, &settings, cue_term);
                 let distance = moved.iter().zip(&end).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
                 let unmoved = end.iter().zip(&scales).map(|(x, s)| x * s).collect();
-                by_cues = Some(HeldByCues { directions: held.len(), distance, before: cue_report.start, after: cue_report.end, unmoved });
+                let (objective_after, _) = eval(&moved);
+                by_cues = Some(HeldByCues {
+                    directions: held.len(),
+                    distance,
+                    before: cue_report.start,
+                    after: cue_report.end,
+                    objective_before: report.end,
+                    objective_after,
+                    unmoved,
+                });
                 end = moved;
             }
         }
@@ -415,4 +440,32 @@ pub fn fit_stage2(
     };
     let kept = masks.map_or(1.0, |(kept, _)| kept);
     MotionFit { parameters, scales, curve, gaussians: fitted.gaussians, kept, newton, held_by_cues }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::HeldByCues;
+
+    fn moved(objective: (f64, f64), cue_term: (f64, f64)) -> HeldByCues {
+        HeldByCues {
+            directions: 1,
+            distance: 1.0,
+            before: cue_term.0,
+            after: cue_term.1,
+            objective_before: objective.0,
+            objective_after: objective.1,
+            unmoved: vec![0.0; 6],
+        }
+    }
+
+    #[test]
+    fn the_views_disagree_with_a_move_where_the_whole_objective_falls_by_less_than_the_cue_term() {
+        // The cue term falls by 1e-5; the whole objective by 4e-6, so the photometric terms rise
+        // by 6e-6: 0.03 % of the objective's 0.02.
+        let rise = moved((0.02, 0.02 - 4e-6), (1e-3, 1e-3 - 1e-5)).photometric_rise();
+        assert!((rise - 3e-4).abs() < 1e-9, "{rise}");
+        // The whole objective falls by more than the cue term: the views ask for the move too.
+        let rise = moved((0.02, 0.02 - 1.5e-5), (1e-3, 1e-3 - 1e-5)).photometric_rise();
+        assert!((rise + 2.5e-4).abs() < 1e-9, "{rise}");
+    }
 }
