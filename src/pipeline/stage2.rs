@@ -260,8 +260,8 @@ fn fit_and_check(
                 h.directions,
                 if h.directions == 1 { "" } else { "s" },
                 h.distance,
-                h.before,
-                h.after,
+                h.cue_before,
+                h.cue_after,
                 100.0 * (h.objective_after - h.objective_before) / h.objective_before.abs().max(f64::MIN_POSITIVE)
             )),
             start.elapsed().as_secs_f64(),

@@ -69,9 +69,9 @@ pub struct HeldByCues {
     /// How far the motion moved along them (scaled units).
     pub distance: f64,
     /// The cue term before and after.
-    pub before: f64,
-    /// See `before`.
-    pub after: f64,
+    pub cue_before: f64,
+    /// See `cue_before`.
+    pub cue_after: f64,
     /// The whole objective of the Newton steps (the photometric terms and the cue term) before
     /// and after.
     pub objective_before: f64,
@@ -86,7 +86,7 @@ impl HeldByCues {
     /// move, as a share of the whole objective before it: over 0, the views disagree with the
     /// move the cues ask for.
     pub fn photometric_rise(&self) -> f64 {
-        let photometric = (self.objective_after - self.after) - (self.objective_before - self.before);
+        let photometric = (self.objective_after - self.cue_after) - (self.objective_before - self.cue_before);
         photometric / self.objective_before.abs().max(f64::MIN_POSITIVE)
     }
 }
@@ -425,8 +425,8 @@ pub fn fit_stage2(
                 by_cues = Some(HeldByCues {
                     directions: held.len(),
                     distance,
-                    before: cue_report.start,
-                    after: cue_report.end,
+                    cue_before: cue_report.start,
+                    cue_after: cue_report.end,
                     objective_before: report.end,
                     objective_after,
                     unmoved,
@@ -450,8 +450,8 @@ mod tests {
         HeldByCues {
             directions: 1,
             distance: 1.0,
-            before: cue_term.0,
-            after: cue_term.1,
+            cue_before: cue_term.0,
+            cue_after: cue_term.1,
             objective_before: objective.0,
             objective_after: objective.1,
             unmoved: vec![0.0; 6],
