@@ -366,7 +366,15 @@ pub fn fit_stage2(
         let mut evaluations = 0;
         // One view at a time, each view's graph freed before the next: the gradient of the mean
         // over every band is the sum of the views' gradients over the number of bands.
-        let eval = |x: &[f64]| {
+        // The cue term's value and gradient at `x`, for the whole objective and alone.
+        let cue_term = |cues: &CueTerm, x: &[f64]| {
+            let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
+            let term = cues.evaluate(tc, model, MotionParams::to_si(scaled.clone(), &scales));
+            let value = term.clone().into_scalar::<f32>() as f64;
+            let grad = scaled.grad(&term.backward()).map_or(vec![0.0; n], |g| host_values(g).into_iter().map(f64::from).collect());
+            (value, grad)
+        };
+        let mut eval = |x: &[f64]| {
             let leaf = || Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
             // Adds `term`'s value and its gradient with respect to `scaled` to `total`.
             let add = |total: &mut (f64, Vec<f64>), term: Tensor<1>, scaled: Tensor<1>| {
@@ -391,17 +399,17 @@ pub fn fit_stage2(
             if bands == 0 {
                 return (f64::NAN, vec![0.0; n]);
             }
-            let mut total = (photometric.0 / bands as f64, photometric.1.iter().map(|g| g / bands as f64).collect());
+            let mut total: (f64, Vec<f64>) = (photometric.0 / bands as f64, photometric.1.iter().map(|g| g / bands as f64).collect());
             if let Some(cues) = cues {
-                let scaled = leaf();
-                add(&mut total, cues.evaluate(tc, model, MotionParams::to_si(scaled.clone(), &scales)), scaled);
+                let (value, grad) = cue_term(cues, x);
+                total.0 += value;
+                total.1.iter_mut().zip(grad).for_each(|(a, b)| *a += b);
             }
             evaluations += 1;
             progress(fit.iterations + evaluations, fit.iterations, total.0 as f32);
             total
         };
         let start: Vec<f64> = host_values(fitted.motion.scaled.val()).into_iter().map(f64::from).collect();
-        let mut eval = eval;
         let (mut end, report) = newton_minimise(&start, &fit.newton, &mut eval);
         // The directions the steps hold, where the photometric objective's minimum lies off the
         // truth, set where the cue term alone is least (docs/results.md), and the whole
@@ -410,15 +418,8 @@ pub fn fit_stage2(
         if let Some(cues) = cues.filter(|_| fit.held_by_cues) {
             let held = held_directions(&end, fit.newton.fd_step, fit.newton.min_curvature_ratio, &mut eval);
             if !held.is_empty() {
-                let cue_term = |x: &[f64]| {
-                    let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
-                    let term = cues.evaluate(tc, model, MotionParams::to_si(scaled.clone(), &scales));
-                    let value = term.clone().into_scalar::<f32>() as f64;
-                    let grad = scaled.grad(&term.backward()).map_or(vec![0.0; n], |g| host_values(g).into_iter().map(f64::from).collect());
-                    (value, grad)
-                };
                 let settings = NewtonSettings { iterations: HELD_BY_CUES_ITERATIONS, ..fit.newton };
-                let (moved, cue_report) = newton_within(&end, &held, &settings, cue_term);
+                let (moved, cue_report) = newton_within(&end, &held, &settings, |x| cue_term(cues, x));
                 let distance = moved.iter().zip(&end).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
                 let unmoved = end.iter().zip(&scales).map(|(x, s)| x * s).collect();
                 let (objective_after, _) = eval(&moved);
