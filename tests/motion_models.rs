@@ -1,14 +1,17 @@
 //! The motion models as tensor programs: they give the poses of FORMAT's laws (checked against
 //! the host implementation used by the generator and the evaluation), their gradients match
 //! finite differences through the whole rolling-shutter render, and the registry builds them by
-//! name.
+//! name, each from the shipped config named after it.
+
+mod common;
 
 use burn::tensor::{Device, Tensor, TensorData};
-use rslf::config::MotionConfig;
+use rslf::config::{Config, MotionConfig};
 use rslf::geometry::{Camera, Pose, TensorCamera, ViewGrid, pose_at};
 use rslf::io::MotionRecord;
 use rslf::model::GaussianSet;
 use rslf::model::motion::{MotionModel, MotionRegistry, MotionSetup, Tabulated};
+use rslf::pipeline::Registries;
 use rslf::render::{RenderSettings, RsTiming, StaticShape, ViewWindow, render_rolling_shutter};
 
 const READOUT: (f64, f64) = (-0.02, 0.02);
@@ -160,6 +163,25 @@ fn the_registry_names_its_models_and_refuses_unknown_ones() {
     assert!(err.contains("helical") && err.contains("constant_velocity"), "{err}");
     let err = registry.build(&MotionConfig { model: "piecewise_constant".into(), segments: 0 }, &setup).err().unwrap().to_string();
     assert!(err.contains("segments"), "{err}");
+}
+
+#[test]
+fn each_built_in_model_has_a_shipped_config_named_after_it_that_reads_and_builds() {
+    let mut names = Vec::new();
+    for entry in std::fs::read_dir(common::project_path("configs")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        let config = Config::read(&path).unwrap_or_else(|e| panic!("{e}"));
+        // Every loss term and the model it names exist and take their settings.
+        Registries::default().check(&config).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let stem = path.file_stem().and_then(|s| s.to_str()).unwrap().to_string();
+        assert_eq!(config.motion.model, stem, "{}", path.display());
+        names.push(stem);
+    }
+    names.sort();
+    assert_eq!(names, MotionRegistry::default().names());
 }
 
 fn camera() -> Camera {
