@@ -289,15 +289,25 @@ fn newton_steps_after_a_short_adam_fit_lower_its_objective_over_every_band_and_l
     // table, and 0.644, 0.662 and 0.624 px with 16 and 64 samples per row and with the poses
     // computed per point. The floor of the valley is flat (the objective ends at 0.08005-0.08006
     // in each): placements that differ by 1e-4 px move where the steps land in it by 0.04 px.
-    let run = |name: &str, newton: usize| {
+    // The steps evaluate the views on the cores in parallel (`threads` of them).
+    let run = |name: &str, newton: usize, threads: &str| {
         let extra = format!("iterations = 10\nmin_cue_support = 0.0\ncue_weight = 0.0\nnewton_iterations = {newton}");
-        let stdout = train(root.path(), &config(root.path(), name, "constant_velocity", &extra), name);
-        let metrics: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(root.path().join(name).join("metrics.json")).unwrap()).unwrap();
+        let config = config(root.path(), name, "constant_velocity", &extra);
+        let out = root.path().join(name);
+        let (ok, stdout, stderr) = common::rslf_with_env(
+            &["train", &config, "--out", out.to_str().unwrap(), "--models", root.path().join("models").to_str().unwrap()],
+            &[("RAYON_NUM_THREADS", Path::new(threads))],
+        );
+        assert!(ok, "{stderr}");
+        let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
         (stdout, metrics["motion"]["image"]["rms_error_px"].as_f64().unwrap())
     };
-    let (adam_log, adam) = run("adam", 0);
-    let (newton_log, newton) = run("newton", 5);
+    let (adam_log, adam) = run("adam", 0, "4");
+    let (newton_log, newton) = run("newton", 5, "4");
+    // However the views are spread over the cores, the steps land on the same motion, to the bit.
+    run("newton_one_thread", 5, "1");
+    let motion = |name: &str| std::fs::read_to_string(root.path().join(name).join("motion.toml")).unwrap();
+    assert_eq!(motion("newton"), motion("newton_one_thread"));
     assert!(!adam_log.contains("Newton"), "{adam_log}");
     // "then T of 5 Newton steps taken over every band, A -> B (E evaluations)"
     let line = newton_log.lines().find(|l| l.starts_with("stage 2 fit: ")).unwrap();

@@ -21,6 +21,7 @@ use crate::random::Rng;
 use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, bands, splat};
 use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
+use rayon::prelude::*;
 
 /// Settings of the stage-2 fit.
 #[derive(Debug, Clone, PartialEq)]
@@ -364,8 +365,6 @@ pub fn fit_stage2(
         let every: Vec<usize> = (0..all_bands.len()).collect();
         let masks = masks.as_ref().map(|(_, m)| m);
         let mut evaluations = 0;
-        // One view at a time, each view's graph freed before the next: the gradient of the mean
-        // over every band is the sum of the views' gradients over the number of bands.
         // The cue term's value and gradient at `x`, for the whole objective and alone.
         let cue_term = |cues: &CueTerm, x: &[f64]| {
             let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
@@ -375,25 +374,34 @@ pub fn fit_stage2(
             (value, grad)
         };
         let mut eval = |x: &[f64]| {
-            let leaf = || Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
-            // Adds `term`'s value and its gradient with respect to `scaled` to `total`.
-            let add = |total: &mut (f64, Vec<f64>), term: Tensor<1>, scaled: Tensor<1>| {
-                total.0 += term.clone().into_scalar::<f32>() as f64;
-                if let Some(g) = scaled.grad(&term.backward()) {
-                    total.1.iter_mut().zip(host_values(g)).for_each(|(a, b)| *a += b as f64);
-                }
-            };
+            // Each view's bands, their summed loss and its gradient, the views on the cores in
+            // parallel, each its own graph, freed once its gradient is read (as many graphs live
+            // at once as there are cores). The gradient of the mean over every band is the sum of
+            // the views' gradients over the number of bands; the sums are added in the views'
+            // order, so the result does not depend on how the views are spread over the cores.
+            let views = (0..targets.len())
+                .into_par_iter()
+                .map(|v| {
+                    let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&p| p as f32).collect(), [n]), device).require_grad();
+                    let params = MotionParams::to_si(scaled.clone(), &scales);
+                    let pass =
+                        Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params, weighted: true, prior: cues.is_none() };
+                    let part = compare(&pass, None, masks, &scaled, &mut |u| if u == v { every.clone() } else { Vec::new() });
+                    let count = part.count();
+                    let sum = part.sum().map(|sum| {
+                        let grad = scaled.grad(&sum.backward()).map_or(vec![0.0; n], host_values);
+                        (sum.into_scalar::<f32>(), grad)
+                    });
+                    (count, sum)
+                })
+                .collect::<Vec<_>>();
             let mut photometric = (0.0, vec![0.0; n]);
             let mut bands = 0;
-            for v in 0..targets.len() {
-                let scaled = leaf();
-                let params = MotionParams::to_si(scaled.clone(), &scales);
-                let pass =
-                    Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params, weighted: true, prior: cues.is_none() };
-                let part = compare(&pass, None, masks, &scaled, &mut |u| if u == v { every.clone() } else { Vec::new() });
-                bands += part.count();
-                if let Some(sum) = part.sum() {
-                    add(&mut photometric, sum, scaled);
+            for (count, sum) in views {
+                bands += count;
+                if let Some((value, grad)) = sum {
+                    photometric.0 += value as f64;
+                    photometric.1.iter_mut().zip(grad).for_each(|(a, b)| *a += b as f64);
                 }
             }
             if bands == 0 {
