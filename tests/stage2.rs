@@ -52,8 +52,15 @@ fn motion_of(dir: &Path, out: &str) -> MotionRecord {
 }
 
 fn train(dir: &Path, config: &str, out: &str) -> String {
+    train_on_threads(dir, config, out, None)
+}
+
+/// [`train`] with rayon's thread count set (`RAYON_NUM_THREADS`), where `threads` names one.
+fn train_on_threads(dir: &Path, config: &str, out: &str, threads: Option<&str>) -> String {
     let out = dir.join(out);
-    let (ok, stdout, stderr) = rslf(&["train", config, "--out", out.to_str().unwrap(), "--models", dir.join("models").to_str().unwrap()]);
+    let env: Vec<(&str, &Path)> = threads.map(|t| ("RAYON_NUM_THREADS", Path::new(t))).into_iter().collect();
+    let (ok, stdout, stderr) =
+        common::rslf_with_env(&["train", config, "--out", out.to_str().unwrap(), "--models", dir.join("models").to_str().unwrap()], &env);
     assert!(ok, "{stderr}");
     stdout
 }
@@ -292,14 +299,9 @@ fn newton_steps_after_a_short_adam_fit_lower_its_objective_over_every_band_and_l
     // The steps evaluate the views on the cores in parallel (`threads` of them).
     let run = |name: &str, newton: usize, threads: &str| {
         let extra = format!("iterations = 10\nmin_cue_support = 0.0\ncue_weight = 0.0\nnewton_iterations = {newton}");
-        let config = config(root.path(), name, "constant_velocity", &extra);
-        let out = root.path().join(name);
-        let (ok, stdout, stderr) = common::rslf_with_env(
-            &["train", &config, "--out", out.to_str().unwrap(), "--models", root.path().join("models").to_str().unwrap()],
-            &[("RAYON_NUM_THREADS", Path::new(threads))],
-        );
-        assert!(ok, "{stderr}");
-        let metrics: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("metrics.json")).unwrap()).unwrap();
+        let stdout = train_on_threads(root.path(), &config(root.path(), name, "constant_velocity", &extra), name, Some(threads));
+        let metrics: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(root.path().join(name).join("metrics.json")).unwrap()).unwrap();
         (stdout, metrics["motion"]["image"]["rms_error_px"].as_f64().unwrap())
     };
     let (adam_log, adam) = run("adam", 0, "4");
