@@ -365,9 +365,11 @@ pub fn fit_stage2(
         let every: Vec<usize> = (0..all_bands.len()).collect();
         let masks = masks.as_ref().map(|(_, m)| m);
         let mut evaluations = 0;
+        // The scaled motion `x` as a leaf of a new graph.
+        let leaf = |x: &[f64]| Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
         // The cue term's value and gradient at `x`, for the whole objective and alone.
         let cue_term = |cues: &CueTerm, x: &[f64]| {
-            let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&v| v as f32).collect(), [n]), device).require_grad();
+            let scaled = leaf(x);
             let term = cues.evaluate(tc, model, MotionParams::to_si(scaled.clone(), &scales));
             let value = term.clone().into_scalar::<f32>() as f64;
             let grad = scaled.grad(&term.backward()).map_or(vec![0.0; n], |g| host_values(g).into_iter().map(f64::from).collect());
@@ -382,7 +384,7 @@ pub fn fit_stage2(
             let views = (0..targets.len())
                 .into_par_iter()
                 .map(|v| {
-                    let scaled = Tensor::<1>::from_data(TensorData::new(x.iter().map(|&p| p as f32).collect(), [n]), device).require_grad();
+                    let scaled = leaf(x);
                     let params = MotionParams::to_si(scaled.clone(), &scales);
                     let pass =
                         Pass { shape: StaticShape::new(&held, tc, model, params.clone()), params, weighted: true, prior: cues.is_none() };
