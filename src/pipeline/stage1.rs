@@ -95,16 +95,21 @@ pub(super) fn sweep(config: &Config, scene: &Scene, log: &mut RunLog) -> Raster 
     let labels = ((settings.range.1 - settings.range.0) / settings.step).round() as u64 + 1;
     let bar = crate::progress::bar(labels, "stage 1: sweep");
     let start = Instant::now();
-    let estimate = plane_sweep(scene, &views, &settings, |done, _| bar.set_position(done as u64));
+    let estimate = plane_sweep(scene, &views, &settings, |done, total| {
+        bar.set_length(total as u64);
+        bar.set_position(done as u64)
+    });
     bar.finish_and_clear();
+    let pixels = estimate.disparity.width * estimate.disparity.height;
     log.push(format!(
-        "stage 1 initialisation: plane sweep over {} central-row and {} central-column views, disparity {:.2}..{:.2} px in {} steps, {:.1} s",
+        "stage 1 initialisation: plane sweep over {} central-row and {} central-column views, disparity {:.2}..{:.2} px in {} steps, {:.1} s; {:.1} % of the pixels filled from their neighbours (a flat or flat-bottomed cost)",
         row_views.len(),
         column.len(),
         settings.range.0,
         settings.range.1,
         labels,
-        start.elapsed().as_secs_f64()
+        start.elapsed().as_secs_f64(),
+        100.0 * estimate.untrusted as f64 / pixels.max(1) as f64
     ));
 
     estimate.disparity
