@@ -12,18 +12,22 @@
 //! a square window, the best candidate is refined to sub-pixel precision by a parabola, and the
 //! depth of the cost minimum below the mean cost of all candidates is kept as a confidence.
 //!
-//! The minimum means nothing in two cases, and those pixels take the disparity of the nearest
-//! trusted pixels left, right, above and below, weighted by inverse distance:
+//! The minimum means nothing in two cases:
 //! - the cost curve is flat (a uniform region, or stripes along the baseline, wider than the
 //!   window seen from every candidate);
 //! - its minimum is flat-bottomed: inside a uniform region (a checker square, a plain panel)
 //!   every candidate that keeps the shifted window inside the region matches, while others
 //!   bring in its border, so the curve is deep but the first of its equal minima, the lowest
 //!   disparity, is arbitrary. A second pass over the candidates counts those within
-//!   [`NEAR_BEST_SHARE`] of the curve's depth of the best; where they span more than the window
-//!   moves in the farthest view, the pixel is not trusted. On the 512 px suite scenes this takes
-//!   BadPix(0.07) of the initialisation from 49-66 % to 16-37 %, on HCI antinous from 22.3 to
-//!   22.2 % (docs/results.md, Stage 1).
+//!   [`NEAR_BEST_SHARE`] of the curve's depth of the best; where they span more disparity
+//!   than moves the window by its width less one pixel in the farthest view, the pixel is not
+//!   trusted.
+//!
+//! An untrusted pixel takes the disparity of the nearest trusted pixels left, right, above and
+//! below whose colour is close to its own, weighted by inverse distance, so that the fill does
+//! not cross an outline into another surface. On the 512 px suite scenes this takes
+//! BadPix(0.07) of the initialisation from 49-66 % to 14-34 %, on HCI antinous from 22.3 to
+//! 22.2 % (docs/results.md, Stage 1).
 
 use super::box_filter::box_mean;
 use crate::geometry::ViewId;
@@ -31,12 +35,16 @@ use crate::io::{Raster, Scene};
 use rayon::prelude::*;
 
 /// Depth of the cost minimum (mean absolute intensity difference) under which a pixel's sweep
-/// result is not trusted and is filled from its confident neighbours.
+/// result is not trusted and is filled from its trusted neighbours.
 pub const MIN_CONFIDENCE: f32 = 2e-3;
 
 /// Share of a pixel's confidence (its cost curve's depth) within which a candidate's cost counts
 /// as matching as well as the best one. 0.05 and 0.2 measured about as well (docs/results.md).
 pub const NEAR_BEST_SHARE: f32 = 0.1;
+
+/// Largest difference in any colour channel (intensities in [0, 1]) between an untrusted pixel
+/// and a trusted one for the second to fill the first, when the pixel has such a source.
+pub const FILL_COLOUR_TOLERANCE: f32 = 0.1;
 
 /// Settings of the sweep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -198,7 +206,8 @@ pub fn plane_sweep(
         confidence.data[i] = if c0.is_finite() && count > 0 { (sum / count as f32 - c0).max(0.0) } else { 0.0 };
     }
     // Second pass: how many candidates match about as well as the best, each counting for
-    // `step * longest` px of movement of the window in the farthest view.
+    // `step * longest` px of movement of the window in the farthest view. A flat bottom and
+    // minima repeated across the range (a periodic texture) are both ambiguous.
     let mut near_best = vec![0u32; n];
     for l in 0..labels {
         let cost = label_cost(l);
@@ -216,27 +225,37 @@ pub fn plane_sweep(
         .zip(&near_best)
         .map(|(&c, &k)| c >= MIN_CONFIDENCE && k as f64 * settings.step * longest as f64 <= span_limit)
         .collect();
-    fill_unconfident(&mut disparity, &trusted);
+    fill_untrusted(&mut disparity, &trusted, central);
     let untrusted = trusted.iter().filter(|&&t| !t).count();
     DisparityEstimate { disparity, confidence, untrusted }
 }
 
-/// Replaces every pixel not `confident` by the inverse-distance-weighted mean of the nearest
-/// confident pixel in each of the four axis directions (left as is when there is none).
-pub fn fill_unconfident(map: &mut Raster, confident: &[bool]) {
+/// Replaces every pixel not `trusted` by the inverse-distance-weighted mean of the nearest
+/// trusted pixel in each of the four axis directions whose colour in `image` lies within
+/// [`FILL_COLOUR_TOLERANCE`] of its own (a fill does not cross an outline into another
+/// surface); where no direction has one, of the nearest trusted pixels whatever their colour;
+/// left as is when there is none. `image` has the map's size.
+pub fn fill_untrusted(map: &mut Raster, trusted: &[bool], image: &Raster) {
     let (w, h) = (map.width, map.height);
-    let mut sum = vec![0.0f64; w * h];
-    let mut weight = vec![0.0f64; w * h];
-    // One scan along a line of pixel indices, carrying the last confident value and its step.
+    let ch = image.channels;
+    let alike = |i: usize, j: usize| (0..ch).all(|k| (image.data[i * ch + k] - image.data[j * ch + k]).abs() <= FILL_COLOUR_TOLERANCE);
+    // Per pixel: (sum, weight) over the like-coloured sources, then over any.
+    let mut like = vec![(0.0f64, 0.0f64); w * h];
+    let mut any = vec![(0.0f64, 0.0f64); w * h];
+    // One scan along a line of pixel indices, carrying the last trusted pixel and its step.
     let mut scan = |line: &mut dyn Iterator<Item = usize>| {
-        let mut last: Option<(f32, usize)> = None;
+        let mut last: Option<(usize, usize)> = None;
         for (step, i) in line.enumerate() {
-            if confident[i] {
-                last = Some((map.data[i], step));
-            } else if let Some((value, at)) = last {
-                let wt = 1.0 / (step - at) as f64;
-                sum[i] += wt * value as f64;
-                weight[i] += wt;
+            if trusted[i] {
+                last = Some((i, step));
+            } else if let Some((source, at)) = last {
+                let (value, wt) = (map.data[source] as f64, 1.0 / (step - at) as f64);
+                any[i].0 += wt * value;
+                any[i].1 += wt;
+                if alike(i, source) {
+                    like[i].0 += wt * value;
+                    like[i].1 += wt;
+                }
             }
         }
     };
@@ -249,8 +268,9 @@ pub fn fill_unconfident(map: &mut Raster, confident: &[bool]) {
         scan(&mut (0..h).rev().map(|y| y * w + x));
     }
     for i in 0..w * h {
-        if !confident[i] && weight[i] > 0.0 {
-            map.data[i] = (sum[i] / weight[i]) as f32;
+        let (sum, weight) = if like[i].1 > 0.0 { like[i] } else { any[i] };
+        if !trusted[i] && weight > 0.0 {
+            map.data[i] = (sum / weight) as f32;
         }
     }
 }
@@ -260,10 +280,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn unconfident_pixels_take_their_confident_neighbours_values() {
-        // A 5x1 row: confident 1.0 at x = 0 and 3.0 at x = 4; the middle is filled by distance.
+    fn untrusted_pixels_take_their_trusted_neighbours_values() {
+        // A 5x1 row: trusted 1.0 at x = 0 and 3.0 at x = 4; the middle is filled by distance.
         let mut map = Raster::from_vec(5, 1, 1, vec![1.0, -9.0, -9.0, -9.0, 3.0]).unwrap();
-        fill_unconfident(&mut map, &[true, false, false, false, true]);
+        let image = Raster::zeros(5, 1, 1);
+        fill_untrusted(&mut map, &[true, false, false, false, true], &image);
         assert_eq!(map.data[0], 1.0);
         assert!((map.data[2] - 2.0).abs() < 1e-6);
         assert!((map.data[1] - (1.0 + 3.0 / 3.0) / (1.0 + 1.0 / 3.0)).abs() < 1e-6);
