@@ -280,6 +280,18 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_fill_takes_like_coloured_sources_first() {
+        // A 6x1 row: trusted 1.0 on a dark surface at x = 0, three untrusted pixels of a light
+        // surface, trusted 3.0 on it at x = 4, and an untrusted pixel of a third colour at x = 5.
+        let mut map = Raster::from_vec(6, 1, 1, vec![1.0, -9.0, -9.0, -9.0, 3.0, -9.0]).unwrap();
+        let image = Raster::from_vec(6, 1, 1, vec![0.2, 0.8, 0.8, 0.8, 0.8, 0.5]).unwrap();
+        fill_untrusted(&mut map, &[true, false, false, false, true, false], &image);
+        assert_eq!(&map.data[1..4], &[3.0, 3.0, 3.0], "the dark surface's value does not cross the outline");
+        // No like-coloured source: the nearest trusted pixels, whatever their colour (x = 4 only).
+        assert_eq!(map.data[5], 3.0);
+    }
+
+    #[test]
     fn untrusted_pixels_take_their_trusted_neighbours_values() {
         // A 5x1 row: trusted 1.0 at x = 0 and 3.0 at x = 4; the middle is filled by distance.
         let mut map = Raster::from_vec(5, 1, 1, vec![1.0, -9.0, -9.0, -9.0, 3.0]).unwrap();
