@@ -6,7 +6,7 @@ mod common;
 use burn::tensor::{Device, Tensor, TensorData};
 use rslf::device::host_values;
 use rslf::model::{GaussianSet, Gaussians};
-use rslf::render::{PixelBins, RenderOutput, RenderSettings, bins_for_view, render};
+use rslf::render::{PixelBins, RenderOutput, RenderSettings, Splats, bins_for_view, render, surface_disparity};
 
 const W: usize = 20;
 const H: usize = 14;
@@ -86,6 +86,48 @@ fn autodiff_gradients_match_central_finite_differences_for_every_parameter_kind(
     }
     assert_eq!(checked, 84);
     assert!(disparity.iter().any(|g| g.abs() > 1e-2), "disparity gradients are exercised");
+}
+
+#[test]
+fn the_surface_disparity_is_the_one_a_foreground_tail_only_tints() {
+    // A small near Gaussian (disparity 2) at u = 4 in front of a wide far one (-1) at u = 8, on
+    // one row: the blended disparity bleeds the near one's tail over the far surface beside it.
+    let set = GaussianSet {
+        u: vec![4.0, 8.0],
+        v: vec![0.0, 0.0],
+        disparity: vec![2.0, -1.0],
+        size: vec![1.5, 4.0],
+        colour: vec![1.0, 0.0],
+        channels: 1,
+    };
+    let device = Device::flex();
+    let g = set.to_module(&device);
+    let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
+    let surface = host_values(surface_disparity(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device));
+    let out = render(&g, (0.0, 0.0), &bins, &device);
+    let blended: Vec<f32> = host_values(out.disparity).iter().zip(host_values(out.alpha)).map(|(d, a)| d / a).collect();
+    assert_eq!(surface[4], 2.0, "the near Gaussian's centre");
+    for x in 6..12 {
+        assert_eq!(surface[x], -1.0, "pixel {x}: {surface:?}");
+    }
+    // Two sigmas (3 px) from the near centre the blended map is still over 0.07 px off the far
+    // surface's -1 (BadPix(0.07) counts the pixel); the surface map is not.
+    assert!(blended[7] > -1.0 + 0.07, "{blended:?}");
+
+    // Two overlapping Gaussians 0.2 px of disparity apart are one surface: between them a pixel
+    // takes their opacity-weighted mean, not the median one's disparity alone.
+    let set = GaussianSet {
+        u: vec![6.0, 10.0],
+        v: vec![0.0, 0.0],
+        disparity: vec![-1.0, -1.2],
+        size: vec![2.0, 2.0],
+        colour: vec![1.0, 0.0],
+        channels: 1,
+    };
+    let g = set.to_module(&device);
+    let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
+    let surface = host_values(surface_disparity(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device));
+    assert!(surface[8] > -1.2 && surface[8] < -1.0 - 0.01, "{surface:?}");
 }
 
 fn render_values(device: &Device) -> Vec<f32> {

@@ -51,10 +51,10 @@ use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::LossRegistry;
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
-use crate::render::{RenderOutput, RenderSettings, RsTiming, StaticShape, render_rows, splat};
+use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, splat, surface_disparity};
 use burn::tensor::{Device, Tensor, TensorData};
 
-/// Opacity above which a rendered pixel's blended disparity is trusted over the initial map.
+/// Opacity above which a rendered pixel's disparity is trusted over the initial map.
 const TRUSTED_ALPHA: f32 = 0.5;
 
 /// The plane-sweep settings a config gives for a scene: the config's range, else the scene's
@@ -156,13 +156,23 @@ pub fn rs_timing(config: &Config) -> RsTiming {
     }
 }
 
-/// Colour and opacity-normalised disparity of a whole-image render; the disparity is
-/// `fallback`'s where the render is not opaque enough.
-fn central_rasters(out: RenderOutput, w: usize, h: usize, c: usize, fallback: &Raster) -> (Raster, Raster) {
+/// Colour and surface disparity ([`surface_disparity`]) of a whole-image render of `splats`; the
+/// disparity is `fallback`'s where the render is not opaque enough.
+fn central_rasters(
+    splats: &Splats,
+    w: usize,
+    h: usize,
+    c: usize,
+    settings: &RenderSettings,
+    fallback: &Raster,
+    device: &Device,
+) -> (Raster, Raster) {
+    let bins = splats.bins(w, 0..h, settings);
+    let out = splat(splats, &bins, device);
     let colour = colour_raster(out.colour, w, h, c);
-    let disparity = host_values(out.disparity);
+    let surface = host_values(surface_disparity(splats, &bins, device));
     let alpha = host_values(out.alpha);
-    let disparity = (0..w * h).map(|i| if alpha[i] > TRUSTED_ALPHA { disparity[i] / alpha[i] } else { fallback.data[i] }).collect();
+    let disparity = (0..w * h).map(|i| if alpha[i] > TRUSTED_ALPHA { surface[i] } else { fallback.data[i] }).collect();
     (colour, Raster { width: w, height: h, channels: 1, data: disparity })
 }
 
@@ -175,7 +185,7 @@ fn colour_raster(colour: Tensor<2>, w: usize, h: usize, c: usize) -> Raster {
 /// (elsewhere `fallback`'s).
 pub fn render_central(g: &Gaussians, scene: &Scene, settings: &RenderSettings, fallback: &Raster, device: &Device) -> (Raster, Raster) {
     let (w, h, c) = (scene.width(), scene.height(), scene.channels());
-    central_rasters(render_rows(g, (0.0, 0.0), w, 0..h, settings, device), w, h, c, fallback)
+    central_rasters(&Splats::of_view(g, (0.0, 0.0)), w, h, c, settings, fallback, device)
 }
 
 /// A parameter vector as a tensor.
@@ -202,7 +212,7 @@ pub fn render_compensated_central(
 ) -> (Raster, Raster) {
     let (w, h, c) = (scene.width(), scene.height(), scene.channels());
     let splats = shape.splats_at_time(model, params_tensor(params, device), (0.0, 0.0), 0.0);
-    central_rasters(splat(&splats, &splats.bins(w, 0..h, settings), device), w, h, c, fallback)
+    central_rasters(&splats, w, h, c, settings, fallback, device)
 }
 
 /// Runs the pipeline on `scene` with `config` on `device`, with the built-in loss terms and
