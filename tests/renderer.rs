@@ -6,7 +6,7 @@ mod common;
 use burn::tensor::{Device, Tensor, TensorData};
 use rslf::device::host_values;
 use rslf::model::{GaussianSet, Gaussians};
-use rslf::render::{PixelBins, RenderOutput, RenderSettings, Splats, bins_for_view, render, surface_disparity};
+use rslf::render::{PixelBins, RenderOutput, RenderSettings, Splats, bins_for_view, render, splat_with_surface};
 
 const W: usize = 20;
 const H: usize = 14;
@@ -103,7 +103,7 @@ fn the_surface_disparity_is_the_one_a_foreground_tail_only_tints() {
     let device = Device::flex();
     let g = set.to_module(&device);
     let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
-    let surface = host_values(surface_disparity(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device));
+    let surface = host_values(splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device).1);
     let out = render(&g, (0.0, 0.0), &bins, &device);
     let blended: Vec<f32> = host_values(out.disparity).iter().zip(host_values(out.alpha)).map(|(d, a)| d / a).collect();
     assert_eq!(surface[4], 2.0, "the near Gaussian's centre");
@@ -126,7 +126,7 @@ fn the_surface_disparity_is_the_one_a_foreground_tail_only_tints() {
     };
     let g = set.to_module(&device);
     let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
-    let surface = host_values(surface_disparity(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device));
+    let surface = host_values(splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device).1);
     assert!(surface[8] > -1.2 && surface[8] < -1.0 - 0.01, "{surface:?}");
 }
 

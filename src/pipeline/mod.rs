@@ -51,7 +51,7 @@ use crate::io::{MotionRecord, Raster, Scene};
 use crate::loss::LossRegistry;
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
-use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, splat, surface_disparity};
+use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, splat_with_surface};
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// Opacity above which a rendered pixel's disparity is trusted over the initial map.
@@ -156,7 +156,7 @@ pub fn rs_timing(config: &Config) -> RsTiming {
     }
 }
 
-/// Colour and surface disparity ([`surface_disparity`]) of a whole-image render of `splats`; the
+/// Colour and surface disparity ([`splat_with_surface`]) of a whole-image render of `splats`; the
 /// disparity is `fallback`'s where the render is not opaque enough.
 fn central_rasters(
     splats: &Splats,
@@ -168,9 +168,9 @@ fn central_rasters(
     device: &Device,
 ) -> (Raster, Raster) {
     let bins = splats.bins(w, 0..h, settings);
-    let out = splat(splats, &bins, device);
+    let (out, surface) = splat_with_surface(splats, &bins, device);
     let colour = colour_raster(out.colour, w, h, c);
-    let surface = host_values(surface_disparity(splats, &bins, device));
+    let surface = host_values(surface);
     let alpha = host_values(out.alpha);
     let disparity = (0..w * h).map(|i| if alpha[i] > TRUSTED_ALPHA { surface[i] } else { fallback.data[i] }).collect();
     (colour, Raster { width: w, height: h, channels: 1, data: disparity })

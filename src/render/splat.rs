@@ -111,31 +111,43 @@ fn blend_weights(s: &Splats, bins: &PixelBins, device: &Device) -> (Tensor<2>, T
     (a * transmittance, dg, cg)
 }
 
-/// Blends `splats` over the pixels of `bins`, front to back.
-pub fn splat(s: &Splats, bins: &PixelBins, device: &Device) -> RenderOutput {
-    let (w, dg, cg) = blend_weights(s, bins, device);
-    let [p, c] = [bins.pixels(), s.colour.dims()[1]];
+/// The colour, blended disparity and opacity of `[P, K]` blending weights `w`.
+fn blend(w: Tensor<2>, dg: Tensor<2>, cg: Tensor<3>) -> RenderOutput {
+    let [p, _, c] = cg.dims();
     let colour = (w.clone().unsqueeze_dim::<3>(2) * cg).sum_dim(1).reshape([p, c]);
     let disparity = (w.clone() * dg).sum_dim(1).reshape([p]);
     let alpha = w.sum_dim(1).reshape([p]);
     RenderOutput { colour, disparity, alpha }
 }
 
+/// Blends `splats` over the pixels of `bins`, front to back.
+pub fn splat(s: &Splats, bins: &PixelBins, device: &Device) -> RenderOutput {
+    let (w, dg, cg) = blend_weights(s, bins, device);
+    blend(w, dg, cg)
+}
+
 /// How far (px of disparity) a splat's disparity may lie from a pixel's median one and still
-/// count as the same surface in [`surface_disparity`]. On HCI antinous BadPix(0.07) 19.5 % with
+/// count as the same surface in [`splat_with_surface`]. On HCI antinous BadPix(0.07) 19.5 % with
 /// the median alone, 19.0 % with 0.1-0.25 px, 19.5 % with 0.5 px (docs/results.md).
 pub const SURFACE_TOLERANCE: f32 = 0.25;
 
-/// The disparity of the surface each pixel of `bins` sees, `[P]`: the opacity-weighted mean
+/// [`splat`], and the disparity of the surface each pixel sees, `[P]`: the opacity-weighted mean
 /// disparity of the splats within [`SURFACE_TOLERANCE`] of the median one (that of the
 /// front-most splat at which the accumulated opacity reaches half the pixel's total). Unlike the
 /// blended disparity (over opacity), it does not mix a surface with the faint tails of the
 /// splats in front of it, which bleed a foreground's disparity over the background beside it.
-/// Not differentiable; for maps that are written or compared, not fitted.
-pub fn surface_disparity(s: &Splats, bins: &PixelBins, device: &Device) -> Tensor<1> {
-    let (w, dg, _) = blend_weights(s, bins, device);
-    let (w, dg) = (w.detach(), dg.detach());
-    let (p, k) = (bins.pixels(), bins.k);
+/// The surface disparity is not differentiable; it is for maps that are written or compared,
+/// not fitted.
+pub fn splat_with_surface(s: &Splats, bins: &PixelBins, device: &Device) -> (RenderOutput, Tensor<1>) {
+    let (w, dg, cg) = blend_weights(s, bins, device);
+    let surface = surface_disparity(w.clone().detach(), dg.clone().detach());
+    (blend(w, dg, cg), surface)
+}
+
+/// The surface disparity ([`splat_with_surface`]) of `[P, K]` blending weights `w` of splats of
+/// disparities `dg`, front to back.
+fn surface_disparity(w: Tensor<2>, dg: Tensor<2>) -> Tensor<1> {
+    let [p, k] = w.dims();
     let accumulated = w.clone().cumsum(1);
     let half = accumulated.clone().slice([0..p, k - 1..k]) * 0.5;
     // The accumulated opacity never falls, so the splats short of half of it are a prefix: their
