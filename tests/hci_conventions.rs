@@ -5,7 +5,7 @@ mod common;
 use common::{hci, rslf};
 use rslf::geometry::{ViewGrid, ViewId};
 use rslf::io::{Scene, read_pfm};
-use rslf::pipeline::stage1_views;
+use rslf::pipeline::{BorderStrips, stage1_views};
 
 #[test]
 fn antinous_loads_81_views_of_512x512_without_a_camera() {
@@ -149,7 +149,7 @@ fn the_disocclusion_mask_of_antinous_corners_leaves_out_what_the_central_view_do
     let scene = Scene::load(&dir).unwrap();
     let gt = read_pfm(&dir.join("gt_disp_lowres.pfm")).unwrap();
     for view in scene.grid.corners() {
-        let mask = rslf::pipeline::explained_mask(&gt, scene.grid.offset(view), 1);
+        let mask = rslf::pipeline::explained_mask(&gt, scene.grid.offset(view), 1, BorderStrips::LeftOut);
         let kept = mask.data.iter().sum::<f32>() / mask.data.len() as f32;
         assert!((0.9..0.999).contains(&kept), "view {view:?}: {kept} kept");
         let (kept_error, left_out_error) = backward_warp_errors(&scene, &gt, view, &mask);

@@ -42,7 +42,7 @@ pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_ga
 pub use stage2::{AXIAL_CHECK_LINE, CHECK_LINE, HELD_CHECK_LINE, REFIT_CHECK_LINE};
 pub use stage2_fit::{HeldByCues, MotionFit, Stage2Context, Stage2Fit, fit_stage2, motion_scales, pose_table};
 pub use view_tracking::{Track, TrackSettings, textured_points, track};
-pub use visibility::explained_mask;
+pub use visibility::{BORDER_CONTINUATION_PX, BorderStrips, explained_mask};
 
 use crate::config::{Config, TimingChoice, ViewSelection};
 use crate::device::host_values;

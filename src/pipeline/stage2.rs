@@ -230,7 +230,14 @@ fn fit_and_check(
             views.len(),
             s.timing,
             if fit.disocclusion_margin.is_some() {
-                format!("{:.1}% of the pixels compared (disocclusions masked)", 100.0 * fitted.kept)
+                format!(
+                    "{:.1}% of the pixels compared (disocclusions masked){}",
+                    100.0 * fitted.kept,
+                    fitted.kept_by_gaussians.map_or(String::new(), |k| format!(
+                        " in the motion's residual, {:.1}% in the Gaussians' (the strips entering at the border left out too)",
+                        100.0 * k
+                    ))
+                )
             } else {
                 "every pixel compared".to_string()
             },
