@@ -155,6 +155,11 @@ struct Masks {
 }
 
 impl Masks {
+    /// Whether the two residuals' masks differ, so that each view is rendered once for each.
+    fn differ(&self) -> bool {
+        self.gaussians.is_some()
+    }
+
     /// The masks `pass` compares through.
     fn of(&self, pass: &Pass) -> &[Vec<Tensor<2>>] {
         match (&self.gaussians, pass.gaussians_masks) {
@@ -314,9 +319,8 @@ pub fn fit_stage2(
             if chosen.is_empty() {
                 continue;
             }
-            let two_masks = masks.is_some_and(|m| m.gaussians.is_some());
             let passes: &[Pass] = match split {
-                Some(split) if aperture[v].is_some() || two_masks => split,
+                Some(split) if aperture[v].is_some() || masks.is_some_and(Masks::differ) => split,
                 _ => std::slice::from_ref(joint),
             };
             let rolling: Vec<Option<Splats>> = passes
@@ -369,7 +373,7 @@ pub fn fit_stage2(
         // (Gaussians held) compares the weighted residual, the Gaussians' pass (motion held)
         // every pixel, so the geometry still learns from the horizontal edges the motion ignores.
         // So is every view where the two residuals' disocclusion masks differ.
-        let two_masks = masks.as_ref().is_some_and(|m| m.gaussians.is_some());
+        let two_masks = masks.as_ref().is_some_and(Masks::differ);
         let split = (fit.refine.is_some() && (two_masks || aperture.iter().any(Option::is_some))).then(|| {
             [
                 Pass {
