@@ -135,6 +135,12 @@ impl Config {
         if self.stage2.band_height == 0 {
             return fail("stage2.band_height", "must be at least 1 row");
         }
+        if self.stage2.mask_disocclusions && !self.stage2.mask_motion_residual && self.stage2.refine_gaussians <= 0.0 {
+            return fail(
+                "stage2.mask_motion_residual",
+                "false masks only the Gaussians' residual, and with refine_gaussians = 0 there is none: set mask_disocclusions = false to compare every pixel",
+            );
+        }
         if self.stage2.disocclusion_margin > 32 {
             return fail("stage2.disocclusion_margin", "must be at most 32 pixels");
         }
@@ -234,6 +240,10 @@ mod tests {
             let err = parse(&format!("[[loss]]\nkind = \"l1\"\nstages = {bad}\n")).unwrap_err();
             assert_eq!(err.key.as_deref(), Some("loss[0].stages"), "{bad}");
         }
+        let err = parse("[stage2]\nmask_motion_residual = false\nrefine_gaussians = 0.0\n").unwrap_err();
+        assert_eq!(err.key.as_deref(), Some("stage2.mask_motion_residual"));
+        assert!(parse("[stage2]\nmask_motion_residual = false\n").is_ok(), "the Gaussians' residual is masked");
+        assert!(parse("[stage2]\nmask_motion_residual = false\nrefine_gaussians = 0.0\nmask_disocclusions = false\n").is_ok());
         let err = parse("[stage2]\ndisocclusion_margin = 1000\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.disocclusion_margin"));
         let err = parse("[stage2]\ncue_weight = -0.5\n").unwrap_err();

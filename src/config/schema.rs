@@ -186,6 +186,10 @@ pub struct Stage2Config {
     /// pixel reaches (surfaces the central view does not see, which the Gaussians cannot
     /// render), so that the motion is not bent to shrink their residuals.
     pub mask_disocclusions: bool,
+    /// With `mask_disocclusions`, leave the disocclusions out of the motion's residual too; false
+    /// masks only the Gaussians' residual (joint refinement, which it then needs), and the motion
+    /// compares every pixel.
+    pub mask_motion_residual: bool,
     /// Pixels by which that mask is widened around each pixel no central-view pixel reaches.
     pub disocclusion_margin: usize,
     /// Weigh each pixel of an off-row view, in the motion's residual, by the share of its local
@@ -288,6 +292,7 @@ impl Default for Stage2Config {
             adam_epsilon: 1e-8,
             refine_gaussians: 1.0,
             mask_disocclusions: true,
+            mask_motion_residual: true,
             disocclusion_margin: 6,
             aperture_weighting: false,
             cue_weight: 1.0,

@@ -192,6 +192,7 @@ fn fit_and_check(
         render: render_settings(config),
         refine,
         disocclusion_margin: s.mask_disocclusions.then_some(s.disocclusion_margin),
+        mask_motion: s.mask_motion_residual,
         aperture_weighting: s.aperture_weighting,
         // No Adam steps, no estimation: a given `initial_motion` is used as it is.
         newton: NewtonSettings {
@@ -229,7 +230,12 @@ fn fit_and_check(
             s.band_height,
             views.len(),
             s.timing,
-            if fit.disocclusion_margin.is_some() {
+            if fit.disocclusion_margin.is_some() && !fit.mask_motion {
+                format!(
+                    "every pixel compared in the motion's residual, {:.1}% in the Gaussians' (disocclusions and the strips entering at the border left out)",
+                    100.0 * fitted.kept_by_gaussians.unwrap_or(1.0)
+                )
+            } else if fit.disocclusion_margin.is_some() {
                 format!(
                     "{:.1}% of the pixels compared (disocclusions masked){}",
                     100.0 * fitted.kept,

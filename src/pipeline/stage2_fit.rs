@@ -53,6 +53,9 @@ pub struct Stage2Fit {
     /// residual the background a foreground uncovers, in the Gaussians' (joint refinement) the
     /// strips entering at the image border too.
     pub disocclusion_margin: Option<usize>,
+    /// Whether the motion's residual leaves the disocclusions out as well; when not, it compares
+    /// every pixel and only the Gaussians' residual (joint refinement) is masked.
+    pub mask_motion: bool,
     /// Weigh the pixels of the views off the central row by [`aperture_weights`] in the motion's
     /// residual, so that residuals a disparity error could equally have caused do not pull the
     /// motion; under joint refinement the Gaussians still compare every pixel.
@@ -143,14 +146,15 @@ struct Pass {
 }
 
 /// Disocclusion masks of the compared views, cut like the targets (`[P, 1]` per view and band),
-/// each with the share of the pixels it keeps: the motion's, which compare the strips entering
-/// at the image border, and under joint refinement the Gaussians', which leave them out. Left
+/// each with the share of the pixels it keeps: the motion's (unless [`Stage2Fit::mask_motion`]
+/// is off), which compare the strips entering at the image border, and under joint refinement
+/// the Gaussians', which leave them out. Left
 /// out of the motion's residual, the strips follow the motion estimate the masks are drawn from
 /// and the fit hides its misfit along the border in them (objects_slow1 at 128 px: 0.164 px,
 /// against 0.050 px compared; docs/results.md); compared in the Gaussians', they pull the
 /// Gaussians along the border into them (the README's scene: BadPix(0.07) 20.1 against 18.2 %).
 struct Masks {
-    motion: (f64, Vec<Vec<Tensor<2>>>),
+    motion: Option<(f64, Vec<Vec<Tensor<2>>>)>,
     gaussians: Option<(f64, Vec<Vec<Tensor<2>>>)>,
 }
 
@@ -160,11 +164,11 @@ impl Masks {
         self.gaussians.is_some()
     }
 
-    /// The masks `pass` compares through.
-    fn of(&self, pass: &Pass) -> &[Vec<Tensor<2>>] {
+    /// The masks `pass` compares through, if any.
+    fn of(&self, pass: &Pass) -> Option<&[Vec<Tensor<2>>]> {
         match (&self.gaussians, pass.gaussians_masks) {
-            (Some((_, cut)), true) => cut,
-            _ => &self.motion.1,
+            (Some((_, cut)), true) => Some(cut),
+            _ => self.motion.as_ref().map(|(_, cut)| cut.as_slice()),
         }
     }
 }
@@ -280,8 +284,9 @@ pub fn fit_stage2(
             let cut = maps.iter().map(|mask| all_bands.iter().map(|(rows, _)| band_tensor(mask, rows.clone(), device)).collect()).collect();
             (kept, cut)
         };
+        let motion = fit.mask_motion.then(|| draw(BorderStrips::Explained));
         let gaussians = fit.refine.is_some().then(|| draw(BorderStrips::LeftOut));
-        Some(Masks { motion: draw(BorderStrips::Explained), gaussians })
+        (motion.is_some() || gaussians.is_some()).then_some(Masks { motion, gaussians })
     };
     let mut masks = draw_masks(&model.record(start));
     // Aperture weights of the off-row views, cut like the targets: `[P, 1]` per (view, band).
@@ -339,8 +344,8 @@ pub fn fit_stage2(
                         None => pass.shape.splats_at_time(model, pass.params.clone(), *offset, tau.expect("bands have a time")),
                     };
                     let out = splat(&splats, &splats.bins(w, rows.clone(), &fit.render), device);
-                    let (out, target) = match masks {
-                        Some(masks) => masked(out, view_bands[b].clone(), masks.of(pass)[v][b].clone()),
+                    let (out, target) = match masks.and_then(|m| m.of(pass)) {
+                        Some(cut) => masked(out, view_bands[b].clone(), cut[v][b].clone()),
                         None => (out, view_bands[b].clone()),
                     };
                     let (out, target) = match (&aperture[v], pass.weighted) {
@@ -501,7 +506,7 @@ pub fn fit_stage2(
     } else {
         (fitted.motion.si_values(&scales), None, None)
     };
-    let kept = masks.as_ref().map_or(1.0, |m| m.motion.0);
+    let kept = masks.as_ref().and_then(|m| m.motion.as_ref()).map_or(1.0, |(kept, _)| *kept);
     let kept_by_gaussians = masks.and_then(|m| m.gaussians).map(|(kept, _)| kept);
     MotionFit { parameters, scales, curve, gaussians: fitted.gaussians, kept, kept_by_gaussians, newton, held_by_cues }
 }
