@@ -230,22 +230,20 @@ fn fit_and_check(
             s.band_height,
             views.len(),
             s.timing,
-            if fit.disocclusion_margin.is_some() && !fit.mask_motion {
-                format!(
-                    "every pixel compared in the motion's residual, {:.1}% in the Gaussians' (disocclusions and the strips entering at the border left out)",
-                    100.0 * fitted.kept_by_gaussians.unwrap_or(1.0)
-                )
-            } else if fit.disocclusion_margin.is_some() {
-                format!(
+            match (fit.disocclusion_margin.is_some(), fit.mask_motion, fitted.kept_by_gaussians) {
+                (true, true, by_gaussians) => format!(
                     "{:.1}% of the pixels compared (disocclusions masked){}",
                     100.0 * fitted.kept,
-                    fitted.kept_by_gaussians.map_or(String::new(), |k| format!(
+                    by_gaussians.map_or(String::new(), |k| format!(
                         " in the motion's residual, {:.1}% in the Gaussians' (the strips entering at the border left out too)",
                         100.0 * k
                     ))
-                )
-            } else {
-                "every pixel compared".to_string()
+                ),
+                (true, false, Some(k)) => format!(
+                    "every pixel compared in the motion's residual, {:.1}% in the Gaussians' (disocclusions and the strips entering at the border left out)",
+                    100.0 * k
+                ),
+                _ => "every pixel compared".to_string(),
             },
             if fit.aperture_weighting { ", off-row pixels weighted by their horizontal gradient share" } else { "" },
             cue_term.map_or(String::new(), |c| format!(", measured-cue term ×{} over {} cues", c.weight, c.len)),
