@@ -119,6 +119,7 @@ fn the_readme_main_command_runs_on_its_built_in_scene() {
     let line = |prefix: &str| stdout.lines().find(|l| l.starts_with(prefix)).unwrap_or_else(|| panic!("no `{prefix}` line: {stdout}"));
     let (stage1, stage2) = (line("stage 1 fit:"), line("stage 2 fit:"));
     assert!(stage1.contains("l1×1 + smoothness×0.05") && !stage1.contains("motion_prior"), "{stage1}");
+    assert!(stage1.contains("the disparities' rate decaying to 0.1 of itself"), "{stage1}");
     assert!(stage2.contains("motion_prior×"), "{stage2}");
     let saved = rslf::model::SavedModel::load(&models.join("result")).unwrap();
     assert_eq!(saved.gaussians.len(), 20_000);

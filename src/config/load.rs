@@ -114,6 +114,9 @@ impl Config {
                 return fail(key, "must be a finite number >= 0");
             }
         }
+        if !(self.stage1.lr_disparity_final_share > 0.0 && self.stage1.lr_disparity_final_share <= 1.0) {
+            return fail("stage1.lr_disparity_final_share", "must be in (0, 1] (1: a constant rate)");
+        }
         if !(self.stage1.adam_epsilon > 0.0 && self.stage1.adam_epsilon.is_finite()) {
             return fail("stage1.adam_epsilon", "must be a positive number");
         }
@@ -244,6 +247,11 @@ mod tests {
         assert_eq!(err.key.as_deref(), Some("stage2.mask_motion_residual"));
         assert!(parse("[stage2]\nmask_motion_residual = false\n").is_ok(), "the Gaussians' residual is masked");
         assert!(parse("[stage2]\nmask_motion_residual = false\nrefine_gaussians = 0.0\nmask_disocclusions = false\n").is_ok());
+        for bad in ["0.0", "1.5", "nan"] {
+            let err = parse(&format!("[stage1]\nlr_disparity_final_share = {bad}\n")).unwrap_err();
+            assert_eq!(err.key.as_deref(), Some("stage1.lr_disparity_final_share"), "{bad}");
+        }
+        assert!(parse("[stage1]\nlr_disparity_final_share = 1.0\n").is_ok(), "a constant rate");
         let err = parse("[stage2]\ndisocclusion_margin = 1000\n").unwrap_err();
         assert_eq!(err.key.as_deref(), Some("stage2.disocclusion_margin"));
         let err = parse("[stage2]\ncue_weight = -0.5\n").unwrap_err();

@@ -85,6 +85,10 @@ pub struct Stage1Config {
     pub lr_size: f64,
     /// Adam learning rate of the colours per step.
     pub lr_colour: f64,
+    /// The disparities' rate decays along a half cosine over the fit to this share of itself
+    /// (1: constant). At a constant rate Adam keeps moving each disparity by about the rate a
+    /// step up to the last one; the decay lets them settle. The other rates stay constant.
+    pub lr_disparity_final_share: f64,
     /// Adam's epsilon (measured on HCI antinous: 1e-15 lets disparities random-walk, BadPix(0.07)
     /// 50.7%; 1e-5 gives 24.7%).
     pub adam_epsilon: f64,
@@ -123,6 +127,7 @@ impl Default for Stage1Config {
             lr_disparity: 0.01,
             lr_size: 0.01,
             lr_colour: 0.01,
+            lr_disparity_final_share: 0.1,
             adam_epsilon: 1e-5,
             initial_disparity: None,
         }

@@ -38,7 +38,9 @@ pub use plane_sweep::{DisparityEstimate, PlaneSweepSettings, plane_sweep};
 pub use results::{LossCurves, PointCloud, RunResult, depth_map};
 pub use run_log::RunLog;
 pub use spline_image::SplineImage;
-pub use stage1_fit::{LearningRates, Stage1Fit, fit_stage1, image_tensor, with_gaussian_groups};
+pub use stage1_fit::{
+    GaussianSchedules, LearningRates, Stage1Fit, decaying, fit_stage1, image_tensor, with_gaussian_groups, with_gaussian_schedules,
+};
 pub use stage2::{AXIAL_CHECK_LINE, CHECK_LINE, HELD_CHECK_LINE, REFIT_CHECK_LINE};
 pub use stage2_fit::{HeldByCues, MotionFit, Stage2Context, Stage2Fit, fit_stage2, motion_scales, pose_table};
 pub use view_tracking::{Track, TrackSettings, textured_points, track};

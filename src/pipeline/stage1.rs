@@ -57,6 +57,7 @@ pub(super) fn run(
             band_height: s.band_height,
             adam_epsilon: s.adam_epsilon as f32,
             lr: LearningRates { position: s.lr_position, disparity: s.lr_disparity, size: s.lr_size, colour: s.lr_colour },
+            disparity_final_share: s.lr_disparity_final_share,
             render: render_settings(config),
         };
         let bar = crate::progress::bar(s.iterations as u64, "stage 1: fit");
@@ -70,8 +71,9 @@ pub(super) fn run(
         // Bands are taken in turn, one a step: a round of them is one pass over the views.
         let ends = curve_ends(&curve, row_bands(0..scene.height(), s.band_height).len());
         log.push(format!(
-            "stage 1 fit: {} Adam steps over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4} over the first and the last round of bands, {:.1} s",
+            "stage 1 fit: {} Adam steps{} over {}-row bands of {} central-row and {} central-column views, loss ({}) {:.4} -> {:.4} over the first and the last round of bands, {:.1} s",
             s.iterations,
+            if s.lr_disparity_final_share < 1.0 { format!(" (the disparities' rate decaying to {} of itself)", s.lr_disparity_final_share) } else { String::new() },
             s.band_height,
             views.iter().filter(|v| v.row == scene.central_id().row).count(),
             views.iter().filter(|v| v.row != scene.central_id().row).count(),
