@@ -6,7 +6,7 @@ mod common;
 use burn::tensor::{Device, Tensor, TensorData};
 use rslf::device::host_values;
 use rslf::model::{GaussianSet, Gaussians};
-use rslf::render::{PixelBins, RenderOutput, RenderSettings, Splats, bins_for_view, render, splat_with_surface};
+use rslf::render::{PixelBins, RenderOutput, RenderSettings, SURFACE_HIDING, Splats, bins_for_view, render, splat_with_surface};
 
 const W: usize = 20;
 const H: usize = 14;
@@ -128,6 +128,34 @@ fn the_surface_disparity_is_the_one_a_foreground_tail_only_tints() {
     let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
     let surface = host_values(splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device).1);
     assert!(surface[8] > -1.2 && surface[8] < -1.0 - 0.01, "{surface:?}");
+}
+
+#[test]
+fn within_a_surface_the_nearer_splat_is_not_favoured_as_compositing_favours_it() {
+    // Two splats of one surface at the same centre, 0.2 px of disparity apart (the near one in
+    // front). One sigma from the centre each has opacity a = exp(-1/2): compositing weighs them
+    // a and a (1 - a); the surface disparity weighs them a and a (1 - a)^SURFACE_HIDING.
+    let set = GaussianSet {
+        u: vec![8.0, 8.0],
+        v: vec![0.0, 0.0],
+        disparity: vec![-0.9, -1.1],
+        size: vec![1.0, 1.0],
+        colour: vec![1.0, 0.0],
+        channels: 1,
+    };
+    let device = Device::flex();
+    let g = set.to_module(&device);
+    let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
+    let (out, surface) = splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device);
+    let surface = host_values(surface);
+    let composited: Vec<f32> = host_values(out.disparity).iter().zip(host_values(out.alpha)).map(|(d, a)| d / a).collect();
+    let a = (-0.5f32).exp();
+    let back = (1.0 - a).powf(SURFACE_HIDING);
+    let expected = (-0.9 - 1.1 * back) / (1.0 + back);
+    assert!((surface[7] - expected).abs() < 1e-5, "{} against {expected}", surface[7]);
+    assert!((composited[7] - (-0.9 - 1.1 * (1.0 - a)) / (2.0 - a)).abs() < 1e-5, "{}", composited[7]);
+    assert!(surface[7] < composited[7] - 0.005, "nearer the surface's mean -1 than compositing: {} against {}", surface[7], composited[7]);
+    assert_eq!(surface[7], surface[9], "symmetric about the centre");
 }
 
 fn render_values(device: &Device) -> Vec<f32> {

@@ -7,4 +7,6 @@ mod splat;
 
 pub use binning::{PixelBins, bin};
 pub use rolling_shutter::{RsTiming, StaticShape, ViewWindow, bands, concat_outputs, render_rolling_shutter, row_bands};
-pub use splat::{ALPHA_MAX, RenderOutput, RenderSettings, Splats, bins_for_view, render, render_rows, splat, splat_with_surface};
+pub use splat::{
+    ALPHA_MAX, RenderOutput, RenderSettings, SURFACE_HIDING, Splats, bins_for_view, render, render_rows, splat, splat_with_surface,
+};
