@@ -88,24 +88,31 @@ fn autodiff_gradients_match_central_finite_differences_for_every_parameter_kind(
     assert!(disparity.iter().any(|g| g.abs() > 1e-2), "disparity gradients are exercised");
 }
 
-#[test]
-fn the_surface_disparity_is_the_one_a_foreground_tail_only_tints() {
-    // A small near Gaussian (disparity 2) at u = 4 in front of a wide far one (-1) at u = 8, on
-    // one row: the blended disparity bleeds the near one's tail over the far surface beside it.
+/// The surface disparity and the composited (blended over opacity) one of the 16 pixels of one
+/// row under Gaussians on that row at columns `u`, front to back by `disparity`, of sizes `size`.
+fn one_row_maps(u: &[f32], disparity: &[f32], size: &[f32]) -> (Vec<f32>, Vec<f32>) {
+    let n = u.len();
     let set = GaussianSet {
-        u: vec![4.0, 8.0],
-        v: vec![0.0, 0.0],
-        disparity: vec![2.0, -1.0],
-        size: vec![1.5, 4.0],
-        colour: vec![1.0, 0.0],
+        u: u.to_vec(),
+        v: vec![0.0; n],
+        disparity: disparity.to_vec(),
+        size: size.to_vec(),
+        colour: (0..n).map(|i| (i % 2) as f32).collect(),
         channels: 1,
     };
     let device = Device::flex();
     let g = set.to_module(&device);
     let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
-    let surface = host_values(splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device).1);
-    let out = render(&g, (0.0, 0.0), &bins, &device);
-    let blended: Vec<f32> = host_values(out.disparity).iter().zip(host_values(out.alpha)).map(|(d, a)| d / a).collect();
+    let (out, surface) = splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device);
+    let composited = host_values(out.disparity).iter().zip(host_values(out.alpha)).map(|(d, a)| d / a).collect();
+    (host_values(surface), composited)
+}
+
+#[test]
+fn the_surface_disparity_is_the_one_a_foreground_tail_only_tints() {
+    // A small near Gaussian (disparity 2) at u = 4 in front of a wide far one (-1) at u = 8, on
+    // one row: the blended disparity bleeds the near one's tail over the far surface beside it.
+    let (surface, blended) = one_row_maps(&[4.0, 8.0], &[2.0, -1.0], &[1.5, 4.0]);
     assert_eq!(surface[4], 2.0, "the near Gaussian's centre");
     for x in 6..12 {
         assert_eq!(surface[x], -1.0, "pixel {x}: {surface:?}");
@@ -115,18 +122,8 @@ fn the_surface_disparity_is_the_one_a_foreground_tail_only_tints() {
     assert!(blended[7] > -1.0 + 0.07, "{blended:?}");
 
     // Two overlapping Gaussians 0.2 px of disparity apart are one surface: between them a pixel
-    // takes their opacity-weighted mean, not the median one's disparity alone.
-    let set = GaussianSet {
-        u: vec![6.0, 10.0],
-        v: vec![0.0, 0.0],
-        disparity: vec![-1.0, -1.2],
-        size: vec![2.0, 2.0],
-        colour: vec![1.0, 0.0],
-        channels: 1,
-    };
-    let g = set.to_module(&device);
-    let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
-    let surface = host_values(splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device).1);
+    // takes a weighted mean of their disparities, not the median one's alone.
+    let (surface, _) = one_row_maps(&[6.0, 10.0], &[-1.0, -1.2], &[2.0, 2.0]);
     assert!(surface[8] > -1.2 && surface[8] < -1.0 - 0.01, "{surface:?}");
 }
 
@@ -135,20 +132,7 @@ fn within_a_surface_the_nearer_splat_is_not_favoured_as_compositing_favours_it()
     // Two splats of one surface at the same centre, 0.2 px of disparity apart (the near one in
     // front). One sigma from the centre each has opacity a = exp(-1/2): compositing weighs them
     // a and a (1 - a); the surface disparity weighs them a and a (1 - a)^SURFACE_HIDING.
-    let set = GaussianSet {
-        u: vec![8.0, 8.0],
-        v: vec![0.0, 0.0],
-        disparity: vec![-0.9, -1.1],
-        size: vec![1.0, 1.0],
-        colour: vec![1.0, 0.0],
-        channels: 1,
-    };
-    let device = Device::flex();
-    let g = set.to_module(&device);
-    let bins = bins_for_view(&set, (0.0, 0.0), 16, 0..1, &RenderSettings::default());
-    let (out, surface) = splat_with_surface(&Splats::of_view(&g, (0.0, 0.0)), &bins, &device);
-    let surface = host_values(surface);
-    let composited: Vec<f32> = host_values(out.disparity).iter().zip(host_values(out.alpha)).map(|(d, a)| d / a).collect();
+    let (surface, composited) = one_row_maps(&[8.0, 8.0], &[-0.9, -1.1], &[1.0, 1.0]);
     let a = (-0.5f32).exp();
     let back = (1.0 - a).powf(SURFACE_HIDING);
     let expected = (-0.9 - 1.1 * back) / (1.0 + back);
