@@ -303,7 +303,8 @@ fn newton_steps_after_a_short_adam_fit_lower_its_objective_over_every_band_and_l
     // and 0.644, 0.662 and 0.624 px with 16 and 64 samples per row and with the poses computed
     // per point. The floor of the valley is flat (the objective ends at 0.08005-0.08006
     // in each): placements that differ by 1e-4 px move where the steps land in it by 0.04 px.
-    // The steps evaluate the views on the cores in parallel (`threads` of them).
+    // The Newton steps, the Adam steps of both stages and their gradients evaluate the views on
+    // the cores in parallel (`threads` of them).
     let run = |name: &str, newton: usize, threads: &str| {
         let extra =
             format!("iterations = 10\nmin_cue_support = 0.0\ncue_weight = 0.0\nmask_disocclusions = false\nnewton_iterations = {newton}");
@@ -314,7 +315,7 @@ fn newton_steps_after_a_short_adam_fit_lower_its_objective_over_every_band_and_l
     };
     let (adam_log, adam) = run("adam", 0, "4");
     let (newton_log, newton) = run("newton", 5, "4");
-    // However the views are spread over the cores, the steps land on the same motion, to the bit.
+    // However the views are spread over the cores, the fit lands on the same motion, to the bit.
     run("newton_one_thread", 5, "1");
     let motion = |name: &str| std::fs::read_to_string(root.path().join(name).join("motion.toml")).unwrap();
     assert_eq!(motion("newton"), motion("newton_one_thread"));

@@ -5,7 +5,6 @@ use super::schedule::{Schedule, Scheduled};
 use burn::module::{Module, ParamGroup, ParamId};
 use burn::optim::lr_scheduler::module_lr_scheduler::ModuleLrScheduler;
 use burn::optim::{AdamConfig, GradientsParams, ModuleOptimizer};
-use burn::tensor::Gradients;
 
 /// How one group of parameters is stepped.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,10 +58,8 @@ impl Optimiser {
         Self { adam, lr }
     }
 
-    /// One Adam step of `module` along the gradients `grads` holds for it; the gradients of
-    /// other modules in `grads` stay there.
-    pub fn step<M: Module>(&mut self, module: M, grads: &mut Gradients) -> M {
-        let params = GradientsParams::from_module(grads, &module);
-        self.adam.step(self.lr.step(), module, params)
+    /// One Adam step of `module` along the gradients `grads` of its parameters.
+    pub fn step<M: Module>(&mut self, module: M, grads: GradientsParams) -> M {
+        self.adam.step(self.lr.step(), module, grads)
     }
 }

@@ -1,7 +1,9 @@
 //! The optimisation loop: a model, a plan, an objective, a number of steps.
 
+use super::gradients::gradients_of;
 use super::plan::{Optimiser, Plan};
 use burn::module::Module;
+use burn::optim::GradientsParams;
 use burn::tensor::Tensor;
 
 /// What an optimisation stage minimises: the loss of a step as a one-element tensor on the
@@ -40,19 +42,28 @@ pub struct StepReport {
 
 /// Runs `stage` on `model` under `objective`; returns the fitted model and the loss of each step
 /// (before its update). `progress` is called after each step.
-pub fn optimise<M: Module>(
+pub fn optimise<M: Module>(model: M, stage: &Stage, mut objective: impl Objective<M>, progress: impl FnMut(StepReport)) -> (M, Vec<f32>) {
+    let by_gradients = |m: &M, step: usize| {
+        let loss = objective.loss(m, step)?;
+        Some((loss.clone().into_scalar::<f32>(), gradients_of(loss, m)))
+    };
+    optimise_by_gradients(model, stage, by_gradients, progress)
+}
+
+/// [`optimise`] under an objective that returns the loss of a step with its gradients with
+/// respect to the model's parameters, or `None` to stop early: one that takes them part by
+/// part ([`super::weighted_sum`]), so that no one graph holds the whole loss.
+pub fn optimise_by_gradients<M: Module>(
     mut model: M,
     stage: &Stage,
-    mut objective: impl Objective<M>,
+    mut objective: impl FnMut(&M, usize) -> Option<(f32, GradientsParams)>,
     mut progress: impl FnMut(StepReport),
 ) -> (M, Vec<f32>) {
     let mut optimiser = Optimiser::new(&stage.plan);
     let mut curve = Vec::with_capacity(stage.iterations);
     for step in 0..stage.iterations {
-        let Some(loss) = objective.loss(&model, step) else { break };
-        let value = loss.clone().into_scalar::<f32>();
-        let mut grads = loss.backward();
-        model = optimiser.step(model, &mut grads);
+        let Some((value, grads)) = objective(&model, step) else { break };
+        model = optimiser.step(model, grads);
         curve.push(value);
         progress(StepReport { step: step + 1, of: stage.iterations, loss: value });
     }

@@ -6,7 +6,7 @@ use crate::geometry::ViewId;
 use crate::io::{Raster, Scene};
 use crate::loss::{LossInput, WeightedLosses};
 use crate::model::Gaussians;
-use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, optimise};
+use crate::optim::{GroupPlan, MeanLoss, Plan, Schedule, Stage, StepReport, mean_over_parts, optimise_by_gradients, weighted_sum};
 use crate::render::{RenderSettings, bins_for_view, render, row_bands};
 use burn::tensor::{Device, Tensor, TensorData};
 
@@ -124,18 +124,23 @@ pub fn fit_stage1(
     let default = GroupPlan { schedule: schedules.position, adam_epsilon: fit.adam_epsilon };
     let plan = with_gaussian_schedules(Plan::new(default), &g, &schedules, fit.adam_epsilon);
     let stage = Stage { iterations: fit.iterations, plan };
+    // The views' gradients are taken one by one ([`mean_over_parts`]): one view's graph at a
+    // time on each core.
     let objective = |g: &Gaussians, step: usize| {
         let b = step % bands.len();
         let set = g.to_set();
-        let mut loss = MeanLoss::default();
-        for (ViewTarget { offset, .. }, target) in targets.iter().zip(&band_targets[b]) {
+        let view = |g: &Gaussians, v: usize| {
+            let (ViewTarget { offset, .. }, target) = (&targets[v], &band_targets[b][v]);
             let bins = bins_for_view(&set, *offset, w, bands[b].clone(), &fit.render);
             let out = render(g, *offset, &bins, device);
+            let mut loss = MeanLoss::default();
             loss.add(losses.evaluate(&LossInput { rendered: &out, target, rows: bands[b].len(), width: w, motion: None }));
-        }
-        loss.mean()
+            loss
+        };
+        let (value, parts) = mean_over_parts(g, targets.len(), device, view)?;
+        Some((value, weighted_sum(g, parts)))
     };
-    optimise(g, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss))
+    optimise_by_gradients(g, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss))
 }
 
 #[cfg(test)]

@@ -14,8 +14,8 @@ use crate::loss::{LossInput, MotionInput, WeightedLosses};
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionParams, ScaleContext, Tabulated, parameter_scales};
 use crate::optim::{
-    GroupPlan, MeanLoss, NewtonReport, NewtonSettings, Plan, Schedule, Stage, StepReport, held_directions, newton_minimise, newton_within,
-    optimise,
+    GroupPlan, MeanLoss, NewtonReport, NewtonSettings, Plan, Schedule, Stage, StepReport, gradients_of, held_directions, mean_over_parts,
+    newton_minimise, newton_within, optimise_by_gradients, weighted_sum,
 };
 use crate::random::Rng;
 use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, bands, splat};
@@ -363,12 +363,10 @@ pub fn fit_stage2(
         }
         loss
     };
-    let objective = |m: &MotionAndScene, step: usize| {
-        if masks.is_some() && step > 0 && step.is_multiple_of(MASK_REFRESH) {
-            masks = draw_masks(&model.record(&m.motion.si_values(&scales)));
-        }
+    // The passes each view is rendered by in a step: `joint`, and under joint refinement the
+    // two of `split` where the view's aperture weights apply or the two residuals' masks differ.
+    let passes = |m: &MotionAndScene, masks: Option<&Masks>| {
         let params = m.motion.si(&scales);
-        let scaled = m.motion.scaled.val();
         let joint = Pass {
             shape: StaticShape::new(&m.gaussians, tc, model, params.clone()),
             params: params.clone(),
@@ -380,7 +378,7 @@ pub fn fit_stage2(
         // (Gaussians held) compares the weighted residual, the Gaussians' pass (motion held)
         // every pixel, so the geometry still learns from the horizontal edges the motion ignores.
         // So is every view where the two residuals' disocclusion masks differ.
-        let two_masks = masks.as_ref().is_some_and(Masks::differ);
+        let two_masks = masks.is_some_and(Masks::differ);
         let split = (fit.refine.is_some() && (two_masks || aperture.iter().any(Option::is_some))).then(|| {
             [
                 Pass {
@@ -399,14 +397,30 @@ pub fn fit_stage2(
                 },
             ]
         });
-        let mut sample = |_| stratified(all_bands.len(), fit.bands_per_step, &mut rng);
-        let photometric = compare(&joint, split.as_ref(), masks.as_ref(), &scaled, &mut sample).mean();
-        match cues {
-            Some(cues) => photometric.map(|l| l + cues.evaluate(tc, model, params)),
-            None => photometric,
-        }
+        (joint, split)
     };
-    let (fitted, curve) = optimise(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
+    // A step's loss is the mean over the bands compared in every view, plus the cue term; its
+    // gradients are taken view by view ([`mean_over_parts`]), so that one view's graph lives at
+    // a time on each core.
+    let objective = |m: &MotionAndScene, step: usize| {
+        if masks.is_some() && step > 0 && step.is_multiple_of(MASK_REFRESH) {
+            masks = draw_masks(&model.record(&m.motion.si_values(&scales)));
+        }
+        let chosen: Vec<Vec<usize>> = (0..targets.len()).map(|_| stratified(all_bands.len(), fit.bands_per_step, &mut rng)).collect();
+        let masks = masks.as_ref();
+        let view = |m: &MotionAndScene, v: usize| {
+            let (joint, split) = passes(m, masks);
+            compare(&joint, split.as_ref(), masks, &m.motion.scaled.val(), &mut |u| if u == v { chosen[v].clone() } else { Vec::new() })
+        };
+        let (mut value, mut parts) = mean_over_parts(m, targets.len(), device, view)?;
+        if let Some(cues) = cues {
+            let term = cues.evaluate(tc, model, m.motion.si(&scales));
+            value += term.clone().into_scalar::<f32>();
+            parts.push((gradients_of(term, m), 1.0));
+        }
+        Some((value, weighted_sum(m, parts)))
+    };
+    let (fitted, curve) = optimise_by_gradients(initial, &stage, objective, |r: StepReport| progress(r.step, r.of, r.loss));
     // Newton steps on the motion alone (Gaussians held), over every band of every view: the
     // objective the motion's Adam steps sample, less the motion prior when the measured cues are
     // in it. The steps hold the directions the views barely observe where Adam left them (their
