@@ -54,6 +54,7 @@ use crate::loss::LossRegistry;
 use crate::model::Gaussians;
 use crate::model::motion::{MotionModel, MotionRegistry, MotionSetup};
 use crate::render::{RenderSettings, RsTiming, Splats, StaticShape, splat_with_surface};
+use burn::module::Module;
 use burn::tensor::{Device, Tensor, TensorData};
 
 /// Opacity above which a rendered pixel's disparity is trusted over the initial map.
@@ -184,10 +185,11 @@ fn colour_raster(colour: Tensor<2>, w: usize, h: usize, c: usize) -> Raster {
 }
 
 /// Renders the central view of `g`: its colour, and its disparity where opaque enough
-/// (elsewhere `fallback`'s).
+/// (elsewhere `fallback`'s). The Gaussians are held (no gradient), so that the whole view's
+/// per-pixel tensors are freed as the render goes instead of kept for a backward pass.
 pub fn render_central(g: &Gaussians, scene: &Scene, settings: &RenderSettings, fallback: &Raster, device: &Device) -> (Raster, Raster) {
     let (w, h, c) = (scene.width(), scene.height(), scene.channels());
-    central_rasters(&Splats::of_view(g, (0.0, 0.0)), w, h, c, settings, fallback, device)
+    central_rasters(&Splats::of_view(&g.clone().no_grad(), (0.0, 0.0)), w, h, c, settings, fallback, device)
 }
 
 /// A parameter vector as a tensor.
@@ -195,9 +197,10 @@ fn params_tensor(params: &[f64], device: &Device) -> Tensor<1> {
     Tensor::from_data(TensorData::new(params.iter().map(|&x| x as f32).collect::<Vec<_>>(), [params.len()]), device)
 }
 
-/// The scene at t = 0 under a motion: the Gaussians moved back from their rows' times.
+/// The scene at t = 0 under a motion: the Gaussians moved back from their rows' times, held (no
+/// gradient: what is rendered from it is an output, not a step of a fit).
 pub fn static_shape(g: &Gaussians, camera: &Camera, model: &dyn MotionModel, params: &[f64], device: &Device) -> StaticShape {
-    StaticShape::new(g, TensorCamera::new(camera), model, params_tensor(params, device))
+    StaticShape::new(&g.clone().no_grad(), TensorCamera::new(camera), model, params_tensor(params, device))
 }
 
 /// Renders the central view at t = 0 of `shape`, the static shape under `model` at `params`
